@@ -1,0 +1,8 @@
+//! mbfmu: multibody model file -> FMI 2.0 Co-Simulation FMU with exact linearization
+//! (Negrut & Ortiz, "On an approach for the linearization of the DAEs of multibody dynamics").
+//!
+//! Data flows one way: [`model`] -> [`mechanics`] -> [`dae`] -> `linearize` -> `fmi`/`cli`.
+
+pub mod ad;
+pub mod geom;
+pub mod model;

@@ -1,0 +1,128 @@
+//! Expression syntax tree, with every name already resolved to an index.
+
+/// Index of a marker in `Model::markers`.
+pub type MarkerId = usize;
+
+/// Binary operators.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BinOp {
+    Add,
+    Sub,
+    Mul,
+    Div,
+    Pow,
+}
+
+/// Plain math functions (argument counts in [`MathFn::arity`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MathFn {
+    Sin,
+    Cos,
+    Tan,
+    Asin,
+    Acos,
+    Atan,
+    Atan2,
+    Sinh,
+    Cosh,
+    Tanh,
+    Exp,
+    Log,
+    Sqrt,
+    Abs,
+    Sign,
+    Min,
+    Max,
+    /// `step(x, x0, h0, x1, h1)`: cubic step.
+    Step,
+    /// `if(c, a, b)`: a where c > 0, else b.
+    If,
+}
+
+/// Kinematic measures between markers: `f(i[, j[, k]])`; `None` = ground frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum KinFn {
+    Dx,
+    Dy,
+    Dz,
+    Dm,
+    Vx,
+    Vy,
+    Vz,
+    Vm,
+    Vr,
+    Wx,
+    Wy,
+    Wz,
+    Wm,
+    Accx,
+    Accy,
+    Accz,
+    Wdtx,
+    Wdty,
+    Wdtz,
+    Ax,
+    Ay,
+    Az,
+    Psi,
+    Theta,
+    Phi,
+    Yaw,
+    Pitch,
+    Roll,
+}
+
+/// Derivative level a kinematic measure needs: 0 positions, 1 velocities, 2 accelerations.
+impl KinFn {
+    /// 0 = positions, 1 = velocities, 2 = accelerations.
+    pub fn level(self) -> u8 {
+        use KinFn::*;
+        match self {
+            Vx | Vy | Vz | Vm | Vr | Wx | Wy | Wz | Wm => 1,
+            Accx | Accy | Accz | Wdtx | Wdty | Wdtz => 2,
+            _ => 0,
+        }
+    }
+}
+
+/// Element loads `fx(name) fy fz tx ty tz`: on the element's i marker, ground components.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LoadFn {
+    Fx,
+    Fy,
+    Fz,
+    Tx,
+    Ty,
+    Tz,
+}
+
+/// What a load function names.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ElementRef {
+    Joint(usize),
+    Motion(usize),
+    Constraint(usize),
+    SpringDamper(usize),
+    Sforce(usize),
+    Gforce(usize),
+}
+
+/// An expression node.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Expr {
+    Num(f64),
+    Time,
+    Param(usize),
+    Input(usize),
+    Variable(usize),
+    /// `dif(name)` or a bare differential name.
+    Diff(usize),
+    /// `dif1(name)`.
+    DiffDot(usize),
+    Neg(Box<Expr>),
+    Bin(BinOp, Box<Expr>, Box<Expr>),
+    Math(MathFn, Vec<Expr>),
+    /// Kinematic measure with markers i, j, k (j, k `None` = ground).
+    Kin(KinFn, MarkerId, Option<MarkerId>, Option<MarkerId>),
+    Load(LoadFn, ElementRef),
+}

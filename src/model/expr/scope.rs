@@ -1,0 +1,31 @@
+//! Name resolution for the expression parser.
+
+use super::ast::{ElementRef, MarkerId};
+
+/// What a bare identifier in an expression names.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum NameRef {
+    Param(usize),
+    Input(usize),
+    Variable(usize),
+    Diff(usize),
+}
+
+/// Resolves names while parsing; implemented by the model parser.
+pub trait Scope {
+    /// A bare identifier (parameter, input, variable, differential).
+    fn name(&self, name: &str) -> Option<NameRef>;
+    /// A marker: `body.marker`, `ground.marker`, or a bare body name (its `cm`).
+    fn marker(&self, name: &str) -> Option<MarkerId>;
+    /// An element named in `fx(name)` and the other load functions.
+    fn element(&self, name: &str) -> Option<ElementRef>;
+}
+
+/// A parse error at a character offset of the expression text.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{msg}")]
+pub struct ExprError {
+    /// 0-based character offset into the expression text.
+    pub offset: usize,
+    pub msg: String,
+}

@@ -1,0 +1,35 @@
+//! The model layer: parse a model file, validate it, resolve names, evaluate constants.
+//! Knows nothing of mechanics, integration or FMI.
+
+pub mod error;
+pub mod expr;
+mod types;
+
+pub use error::ModelError;
+pub use types::*;
+
+/// A complete, validated model (the parsed file). Bodies are numbered from 0; ground is
+/// not a body (`None` where a body index is optional). Markers include each body's `cm`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Model {
+    pub name: String,
+    /// Path of the file it was read from (for messages).
+    pub file: String,
+    pub parameters: Vec<Parameter>,
+    pub gravity: [f64; 3],
+    pub bodies: Vec<Body>,
+    pub markers: Vec<Marker>,
+    pub joints: Vec<Joint>,
+    pub motions: Vec<Motion>,
+    pub constraints: Vec<UserConstraint>,
+    pub spring_dampers: Vec<SpringDamper>,
+    pub sforces: Vec<Sforce>,
+    pub gforces: Vec<Gforce>,
+    pub inputs: Vec<Input>,
+    pub outputs: Vec<Output>,
+    pub lin_states: Vec<LinState>,
+    pub lin_velocities: Vec<LinVelocity>,
+    pub experiment: Experiment,
+    /// `<analysis static="true"/>`.
+    pub static_analysis: bool,
+}
