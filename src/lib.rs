@@ -6,3 +6,4 @@
 pub mod ad;
 pub mod geom;
 pub mod model;
+pub mod dae;
