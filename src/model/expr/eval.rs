@@ -50,15 +50,7 @@ fn ev<T: Real, E: ExprEnv<T> + ?Sized>(e: &Expr, env: &E, slot: &mut usize) -> T
                 BinOp::Pow => a.pow(b),
             }
         }
-        Expr::Math(f, args) => {
-            // Every argument is evaluated (also the branch `if` does not take) so that
-            // angle slots do not depend on the branch.
-            let mut x = [T::zero(); 5];
-            for (xi, a) in x.iter_mut().zip(args) {
-                *xi = ev(a, env, slot);
-            }
-            math(*f, &x)
-        }
+        Expr::Math(f, args) => math(*f, args, env, slot),
         Expr::Kin(f, i, j, k) => {
             let v = kin(*f, *i, *j, *k, env);
             if f.is_angle() {
@@ -73,9 +65,12 @@ fn ev<T: Real, E: ExprEnv<T> + ?Sized>(e: &Expr, env: &E, slot: &mut usize) -> T
     }
 }
 
-/// A math function of already evaluated arguments (`x` holds at least `f.arity()` values).
-fn math<T: Real>(f: MathFn, x: &[T; 5]) -> T {
-    let a = x[0];
+/// A math function of its argument expressions. Every argument is evaluated (also the
+/// branch `if` does not take) so that angle slots do not depend on the branch; a missing
+/// argument (impossible for parsed expressions) reads as NaN.
+fn math<T: Real, E: ExprEnv<T> + ?Sized>(f: MathFn, args: &[Expr], env: &E, slot: &mut usize) -> T {
+    let mut arg = |n: usize| args.get(n).map_or(T::cst(f64::NAN), |a| ev(a, env, slot));
+    let a = arg(0);
     match f {
         MathFn::Sin => a.sin(),
         MathFn::Cos => a.cos(),
@@ -83,7 +78,7 @@ fn math<T: Real>(f: MathFn, x: &[T; 5]) -> T {
         MathFn::Asin => a.asin(),
         MathFn::Acos => a.acos(),
         MathFn::Atan => a.atan(),
-        MathFn::Atan2 => a.atan2(x[1]),
+        MathFn::Atan2 => a.atan2(arg(1)),
         MathFn::Sinh => a.sinh(),
         MathFn::Cosh => a.cosh(),
         MathFn::Tanh => a.tanh(),
@@ -102,21 +97,15 @@ fn math<T: Real>(f: MathFn, x: &[T; 5]) -> T {
             })
         }
         MathFn::Min => {
-            if a.val() <= x[1].val() {
-                a
-            } else {
-                x[1]
-            }
+            let b = arg(1);
+            if a.val() <= b.val() { a } else { b }
         }
         MathFn::Max => {
-            if a.val() >= x[1].val() {
-                a
-            } else {
-                x[1]
-            }
+            let b = arg(1);
+            if a.val() >= b.val() { a } else { b }
         }
         MathFn::Step => {
-            let [x, x0, h0, x1, h1] = *x;
+            let (x, x0, h0, x1, h1) = (a, arg(1), arg(2), arg(3), arg(4));
             if x.val() <= x0.val() {
                 h0
             } else if x.val() >= x1.val() {
@@ -127,11 +116,8 @@ fn math<T: Real>(f: MathFn, x: &[T; 5]) -> T {
             }
         }
         MathFn::If => {
-            if a.val() > 0.0 {
-                x[1]
-            } else {
-                x[2]
-            }
+            let (b, c) = (arg(1), arg(2));
+            if a.val() > 0.0 { b } else { c }
         }
     }
 }
