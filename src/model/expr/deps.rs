@@ -14,8 +14,11 @@ pub struct Deps {
     pub level: u8,
     /// Reads `time`.
     pub time: bool,
+    /// Parameter indices.
     pub params: Vec<usize>,
+    /// Input indices.
     pub inputs: Vec<usize>,
+    /// User variable indices.
     pub variables: Vec<usize>,
     /// Differential states (`dif(x)` or bare `x`).
     pub diffs: Vec<usize>,

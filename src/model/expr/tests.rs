@@ -200,8 +200,8 @@ fn random_z(rng: &mut Lcg) -> Vec<f64> {
         }
     }
     z[T_TIME] = rng.uniform(0.0, 3.0);
-    for i in T_INPUT..NZ {
-        z[i] = rng.uniform(-1.0, 1.0);
+    for x in &mut z[T_INPUT..] {
+        *x = rng.uniform(-1.0, 1.0);
     }
     z[T_PARAM] = rng.uniform(0.5, 2.0);
     z[T_PARAM + 1] = rng.uniform(0.5, 2.0);
