@@ -238,3 +238,43 @@ fn kinematic_functions_are_accepted_where_allowed() {
     let m = load_str(text, "k.xml").unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(m.outputs.len(), 1);
 }
+
+#[test]
+fn load_file_labels_messages_with_the_path() {
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/malformed/21_zero_mass.xml");
+    let e = mbfmu::model::load_file(&path)
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    assert_eq!(
+        e,
+        format!(
+            "{}:2:18: body 'b': mass must be positive (got 0)",
+            path.display()
+        )
+    );
+    let missing = std::path::Path::new("/nonexistent/model.xml");
+    let e = mbfmu::model::load_file(missing)
+        .err()
+        .map(|e| e.msg)
+        .unwrap_or_default();
+    assert!(e.starts_with("cannot read"), "{e}");
+}
+
+#[test]
+fn no_input_makes_the_reader_panic() {
+    // Truncations of a valid model: every prefix must give Ok or Err, never a panic.
+    for cut in (0..FULL.len()).filter(|&i| FULL.is_char_boundary(i)) {
+        let _ = load_str(&FULL[..cut], "cut.xml");
+    }
+    // Each single character deleted, or replaced by a troublesome one.
+    for (i, c) in FULL.char_indices() {
+        let rest = &FULL[i + c.len_utf8()..];
+        for rep in ["", "\"", "<", ",", "0", "é"] {
+            let _ = load_str(&format!("{}{rep}{rest}", &FULL[..i]), "mut.xml");
+        }
+    }
+    let deep = "<multibody name=\"m\" version=\"1\">".to_string() + &"<ground>".repeat(100_000);
+    assert!(load_str(&deep, "deep.xml").is_err());
+}

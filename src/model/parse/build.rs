@@ -358,8 +358,15 @@ fn opt_marker_ref(el: &El, attr: &str) -> Result<Option<MarkerId>, ModelError> {
     };
     let name = a.value.trim();
     let lead = a.value.len() - a.value.trim_start().len();
-    el.scope
-        .marker(name)
-        .map(Some)
-        .ok_or_else(|| el.err_at(el.value_pos(a, lead), format!("unknown marker '{name}'")))
+    let hint = if name == "ground" {
+        " (ground has no cm marker: name one, ground.<marker>)"
+    } else {
+        ""
+    };
+    el.scope.marker(name).map(Some).ok_or_else(|| {
+        el.err_at(
+            el.value_pos(a, lead),
+            format!("unknown marker '{name}'{hint}"),
+        )
+    })
 }

@@ -37,6 +37,9 @@ impl XElem {
     }
 }
 
+/// Deepest element nesting accepted (the format needs 3; this bounds recursion).
+const MAX_DEPTH: usize = 32;
+
 /// Parse the whole text; returns the single root element.
 pub(crate) fn read(src: &Source) -> Result<XElem, ModelError> {
     let mut reader = Reader::from_str(src.text);
@@ -57,7 +60,18 @@ pub(crate) fn read(src: &Source) -> Result<XElem, ModelError> {
             }
         };
         match ev {
-            Event::Start(e) => stack.push(element(src, &e, before)?),
+            Event::Start(e) => {
+                let el = element(src, &e, before)?;
+                if stack.len() >= MAX_DEPTH {
+                    return Err(src.error(
+                        el.pos,
+                        &el.tag,
+                        el.label(),
+                        "elements nested too deeply",
+                    ));
+                }
+                stack.push(el);
+            }
             Event::Empty(e) => {
                 let el = element(src, &e, before)?;
                 attach(src, &mut stack, &mut root, el)?;
