@@ -26,11 +26,7 @@ macro_rules! case {
     };
 }
 
-case!(
-    m01_unknown_element,
-    "01_unknown_element.xml",
-    "01_unknown_element.xml:2:3: bodie 'b': unknown element"
-);
+case!(m01_unknown_element, "01_unknown_element.xml", "01_unknown_element.xml:2:3: bodie 'b': unknown element");
 
 case!(
     m02_unknown_attribute,
@@ -83,11 +79,7 @@ case!(
     "09_unknown_marker_in_function.xml:4:37: constraint 'c': bad expression in 'function': unknown marker 'b.nope'"
 );
 
-case!(
-    m10_unknown_marker,
-    "10_unknown_marker.xml",
-    "10_unknown_marker.xml:4:38: joint 'j': unknown marker 'b.nope'"
-);
+case!(m10_unknown_marker, "10_unknown_marker.xml", "10_unknown_marker.xml:4:38: joint 'j': unknown marker 'b.nope'");
 
 case!(
     m11_duplicate_body,
@@ -149,11 +141,7 @@ case!(
     "20_motion_wrong_joint.xml:4:31: motion 'mo': dof 'rotation' needs a revolute or cylindrical joint; joint 'j' is translational"
 );
 
-case!(
-    m21_zero_mass,
-    "21_zero_mass.xml",
-    "21_zero_mass.xml:2:18: body 'b': mass must be positive (got 0)"
-);
+case!(m21_zero_mass, "21_zero_mass.xml", "21_zero_mass.xml:2:18: body 'b': mass must be positive (got 0)");
 
 case!(
     m22_inertia_not_positive_definite,
@@ -213,11 +201,7 @@ case!(
     "30_bad_version.xml:1:21: multibody 'm': unsupported version '2' (this reader knows version \"1\")"
 );
 
-case!(
-    m31_two_roots,
-    "31_two_roots.xml",
-    "31_two_roots.xml:3:1: multibody 'n': more than one root element"
-);
+case!(m31_two_roots, "31_two_roots.xml", "31_two_roots.xml:3:1: multibody 'n': more than one root element");
 
 case!(
     m32_ground_twice,
@@ -261,11 +245,7 @@ case!(
     "38_euler_and_z_axis.xml:2:77: body 'b': give either euler313 or z_axis [x_axis], not both"
 );
 
-case!(
-    m39_zero_z_axis,
-    "39_zero_z_axis.xml",
-    "39_zero_z_axis.xml:2:45: marker 'O': z_axis is zero"
-);
+case!(m39_zero_z_axis, "39_zero_z_axis.xml", "39_zero_z_axis.xml:2:45: marker 'O': z_axis is zero");
 
 case!(
     m40_x_axis_parallel,
@@ -303,11 +283,7 @@ case!(
     "45_duplicate_linearization_state.xml:4:12: state 's': duplicate linearization state name 's' (first defined at line 3)"
 );
 
-case!(
-    m46_unexpected_text,
-    "46_unexpected_text.xml",
-    "46_unexpected_text.xml:2:3: multibody 'm': unexpected text"
-);
+case!(m46_unexpected_text, "46_unexpected_text.xml", "46_unexpected_text.xml:2:3: multibody 'm': unexpected text");
 
 case!(
     m47_malformed_xml,
@@ -315,11 +291,7 @@ case!(
     "47_malformed_xml.xml:3:1: xml 'document': malformed XML: ill-formed document: expected `</body>`, but `</multibody>` was found"
 );
 
-case!(
-    m48_unknown_joint,
-    "48_unknown_joint.xml",
-    "48_unknown_joint.xml:4:28: motion 'mo': unknown joint 'nope'"
-);
+case!(m48_unknown_joint, "48_unknown_joint.xml", "48_unknown_joint.xml:4:28: motion 'mo': unknown joint 'nope'");
 
 case!(
     m49_negative_mass_from_parameter,
