@@ -60,21 +60,18 @@ case!(
 );
 
 case!(
-    #[ignore = "needs expr parser"]
     m07_unknown_function,
     "07_unknown_function.xml",
     "07_unknown_function.xml:4:34: constraint 'c': bad expression in 'function': unknown function 'foo'"
 );
 
 case!(
-    #[ignore = "needs expr parser"]
     m08_wrong_argument_count,
     "08_wrong_argument_count.xml",
     "08_wrong_argument_count.xml:4:34: constraint 'c': bad expression in 'function': 'atan2' takes 2 arguments, got 1"
 );
 
 case!(
-    #[ignore = "needs expr parser"]
     m09_unknown_marker_in_function,
     "09_unknown_marker_in_function.xml",
     "09_unknown_marker_in_function.xml:4:37: constraint 'c': bad expression in 'function': unknown marker 'b.nope'"
@@ -163,28 +160,24 @@ case!(
 );
 
 case!(
-    #[ignore = "needs expr parser"]
     m25_constraint_uses_velocity,
     "25_constraint_uses_velocity.xml",
     "25_constraint_uses_velocity.xml:4:24: constraint 'c': 'function' may use only positions, time and parameters (it uses velocities)"
 );
 
 case!(
-    #[ignore = "needs expr parser"]
     m26_motion_uses_marker,
     "26_motion_uses_marker.xml",
     "26_motion_uses_marker.xml:5:46: motion 'mo': 'function' may use only time and parameters (it uses marker measures)"
 );
 
 case!(
-    #[ignore = "needs expr parser"]
     m27_sforce_uses_acceleration,
     "27_sforce_uses_acceleration.xml",
     "27_sforce_uses_acceleration.xml:4:60: sforce 's': forces depending on accelerations or loads are not supported yet"
 );
 
 case!(
-    #[ignore = "needs expr parser"]
     m28_gforce_uses_load,
     "28_gforce_uses_load.xml",
     "28_gforce_uses_load.xml:5:26: gforce 'g': forces depending on accelerations or loads are not supported yet"

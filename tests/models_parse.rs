@@ -184,7 +184,7 @@ fn minimal_model_has_defaults() {
 }
 
 #[test]
-#[ignore = "needs expr parser"]
+
 fn kinematic_functions_are_accepted_where_allowed() {
     let text = r#"<multibody name="k" version="1">
   <ground><marker name="O" position="0 0 0"/></ground>
