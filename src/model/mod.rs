@@ -3,6 +3,9 @@
 
 pub mod error;
 pub mod expr;
+// TEMPORARY (branch cli): stub parser until the real `parse.rs` is merged.
+#[path = "parse_stub.rs"]
+pub mod parse;
 mod types;
 
 pub use error::ModelError;
