@@ -3,12 +3,11 @@
 
 pub mod error;
 pub mod expr;
-// TEMPORARY (branch cli): stub parser until the real `parse.rs` is merged.
-#[path = "parse_stub.rs"]
 pub mod parse;
 mod types;
 
 pub use error::ModelError;
+pub use parse::{Summary, load_file, load_str, rotation, try_rotation};
 pub use types::*;
 
 /// A complete, validated model (the parsed file). Bodies are numbered from 0; ground is
@@ -20,6 +19,8 @@ pub struct Model {
     pub file: String,
     pub parameters: Vec<Parameter>,
     pub gravity: [f64; 3],
+    /// The `<gravity>` expressions (`None`: no gravity); `gravity` holds their values.
+    pub gravity_expr: Option<NumVec>,
     pub bodies: Vec<Body>,
     pub markers: Vec<Marker>,
     pub joints: Vec<Joint>,
