@@ -18,10 +18,7 @@ pub struct SimOptions {
 
 impl Default for SimOptions {
     fn default() -> Self {
-        SimOptions {
-            tol: 1e-6,
-            max_step: None,
-        }
+        SimOptions { tol: 1e-6, max_step: None }
     }
 }
 
@@ -74,12 +71,7 @@ impl Simulator {
     /// State of body `b` (model order).
     pub fn body_state(&self, b: usize) -> BodyState {
         let _ = b;
-        BodyState {
-            position: [0.0; 3],
-            rotation: [[0.0; 3]; 3],
-            velocity: [0.0; 3],
-            angular_velocity: [0.0; 3],
-        }
+        BodyState { position: [0.0; 3], rotation: [[0.0; 3]; 3], velocity: [0.0; 3], angular_velocity: [0.0; 3] }
     }
     /// Kinetic + gravitational potential + spring potential energy.
     pub fn mechanical_energy(&self) -> f64 {

@@ -1,0 +1,252 @@
+//! Attribute access for one element: allowed/required checks, vector splitting, constant
+//! numbers and expressions, each error located at the attribute (or the offending char).
+
+use super::names::ModelScope;
+use super::source::Source;
+use super::xml::{XAttr, XElem};
+use crate::model::expr::{self, Expr};
+use crate::model::{ModelError, Num, NumVec, SrcPos};
+
+/// One element being read, with what its constant attributes may use.
+pub(crate) struct El<'a> {
+    pub x: &'a XElem,
+    pub src: &'a Source<'a>,
+    pub scope: &'a ModelScope,
+    /// Evaluated parameter values (empty while parameters themselves are read).
+    pub params: &'a [f64],
+}
+
+/// Split a vector attribute: on commas if there is any, else on white space. Each item
+/// comes with the character offset of its first character.
+pub(crate) fn split_items(s: &str) -> Vec<(usize, &str)> {
+    let mut out = Vec::new();
+    if s.contains(',') {
+        let mut start = 0;
+        for part in s.split(',') {
+            let lead = part.len() - part.trim_start().len();
+            out.push((s[..start + lead].chars().count(), part.trim()));
+            start += part.len() + 1;
+        }
+    } else {
+        let mut item_start: Option<(usize, usize)> = None;
+        for (ci, (b, c)) in s.char_indices().enumerate() {
+            if c.is_whitespace() {
+                if let Some((cs, bs)) = item_start.take() {
+                    out.push((cs, &s[bs..b]));
+                }
+            } else if item_start.is_none() {
+                item_start = Some((ci, b));
+            }
+        }
+        if let Some((cs, bs)) = item_start {
+            out.push((cs, &s[bs..]));
+        }
+    }
+    out
+}
+
+impl<'a> El<'a> {
+    /// An error on this element at `pos`.
+    pub fn err_at(&self, pos: SrcPos, msg: impl Into<String>) -> ModelError {
+        self.src.error(pos, &self.x.tag, self.x.label(), msg)
+    }
+    /// An error on this element at its `<`.
+    pub fn err(&self, msg: impl Into<String>) -> ModelError {
+        self.err_at(self.x.pos, msg)
+    }
+
+    /// Reject attributes not in `allowed`, and require those in `required`.
+    pub fn check_attrs(&self, allowed: &[&str], required: &[&str]) -> Result<(), ModelError> {
+        for a in &self.x.attrs {
+            if !allowed.contains(&a.name.as_str()) {
+                return Err(self.err_at(a.pos, format!("unknown attribute '{}'", a.name)));
+            }
+        }
+        for r in required {
+            self.req(r)?;
+        }
+        Ok(())
+    }
+
+    /// Attribute `name`, if present.
+    pub fn get(&self, name: &str) -> Option<&'a XAttr> {
+        self.x.attr(name)
+    }
+    /// Attribute `name`, required.
+    pub fn req(&self, name: &str) -> Result<&'a XAttr, ModelError> {
+        self.get(name)
+            .ok_or_else(|| self.err(format!("missing required attribute '{name}'")))
+    }
+
+    /// Position of character `char_off` of attribute `a`'s value.
+    pub fn value_pos(&self, a: &XAttr, char_off: usize) -> SrcPos {
+        let Some(start) = a.value_off else {
+            return a.pos;
+        };
+        let rest = self.src.text.get(start..).unwrap_or("");
+        let byte = rest
+            .char_indices()
+            .nth(char_off)
+            .map_or(rest.len(), |(b, _)| b);
+        self.src.pos(start + byte)
+    }
+
+    /// Parse `text` (item at char offset `off` of attribute `a`) as an expression.
+    pub fn parse_expr(&self, a: &XAttr, off: usize, text: &str) -> Result<Expr, ModelError> {
+        expr::parse(text, self.scope).map_err(|e| {
+            self.err_at(
+                self.value_pos(a, off + e.offset),
+                format!("bad expression in '{}': {}", a.name, e.msg),
+            )
+        })
+    }
+
+    /// Parse a constant expression (numbers, `pi`, parameters) without evaluating it.
+    pub fn const_expr(&self, a: &XAttr, off: usize, text: &str) -> Result<Expr, ModelError> {
+        let e = self.parse_expr(a, off, text)?;
+        if !expr::is_constant(&e) {
+            return Err(self.err_at(
+                self.value_pos(a, off),
+                format!(
+                    "'{}' must be a constant expression (numbers, pi, parameters)",
+                    a.name
+                ),
+            ));
+        }
+        Ok(e)
+    }
+
+    /// Parse and evaluate one constant item.
+    fn num_item(&self, a: &XAttr, off: usize, text: &str) -> Result<Num, ModelError> {
+        let e = self.const_expr(a, off, text)?;
+        let value = expr::const_value(&e, self.params);
+        if !value.is_finite() {
+            return Err(self.err_at(
+                self.value_pos(a, off),
+                format!("'{}' evaluates to {value}", a.name),
+            ));
+        }
+        Ok(Num { expr: e, value })
+    }
+
+    /// Optional constant attribute.
+    pub fn num(&self, name: &str) -> Result<Option<Num>, ModelError> {
+        let Some(a) = self.get(name) else {
+            return Ok(None);
+        };
+        let off = a.value.len() - a.value.trim_start().len();
+        self.num_item(a, a.value[..off].chars().count(), a.value.trim())
+            .map(Some)
+    }
+    /// Constant attribute with a default value.
+    pub fn num_or(&self, name: &str, default: f64) -> Result<Num, ModelError> {
+        Ok(self.num(name)?.unwrap_or_else(|| constant(default)))
+    }
+    /// Required constant attribute.
+    pub fn num_req(&self, name: &str) -> Result<Num, ModelError> {
+        self.req(name)?;
+        self.num(name)?
+            .ok_or_else(|| self.err(format!("missing required attribute '{name}'")))
+    }
+
+    /// Split attribute `a` into items, checking the count is one of `counts`.
+    fn items(&self, a: &'a XAttr, counts: &[usize]) -> Result<Vec<(usize, &'a str)>, ModelError> {
+        let items = split_items(&a.value);
+        if !counts.contains(&items.len()) {
+            let want = counts
+                .iter()
+                .map(|c| c.to_string())
+                .collect::<Vec<_>>()
+                .join(" or ");
+            return Err(self.err_at(
+                a.pos,
+                format!(
+                    "attribute '{}' needs {want} items, found {}",
+                    a.name,
+                    items.len()
+                ),
+            ));
+        }
+        Ok(items)
+    }
+
+    /// Optional constant vector attribute with one of the item counts `counts`.
+    pub fn num_vec(&self, name: &str, counts: &[usize]) -> Result<Option<NumVec>, ModelError> {
+        let Some(a) = self.get(name) else {
+            return Ok(None);
+        };
+        let items = self
+            .items(a, counts)?
+            .into_iter()
+            .map(|(off, t)| self.num_item(a, off, t))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(Some(NumVec { items }))
+    }
+    /// Required constant 3-vector.
+    pub fn vec3_req(&self, name: &str) -> Result<NumVec, ModelError> {
+        self.req(name)?;
+        self.num_vec(name, &[3])?
+            .ok_or_else(|| self.err(format!("missing required attribute '{name}'")))
+    }
+
+    /// Required expression attribute.
+    pub fn expr_req(&self, name: &str) -> Result<Expr, ModelError> {
+        let a = self.req(name)?;
+        let off = a.value.len() - a.value.trim_start().len();
+        self.parse_expr(a, a.value[..off].chars().count(), a.value.trim())
+    }
+
+    /// Optional vector of three expressions (default zeros).
+    pub fn expr_vec3(&self, name: &str) -> Result<[Expr; 3], ModelError> {
+        let Some(a) = self.get(name) else {
+            return Ok([Expr::Num(0.0), Expr::Num(0.0), Expr::Num(0.0)]);
+        };
+        let items = self.items(a, &[3])?;
+        let mut out = Vec::with_capacity(3);
+        for (off, t) in items {
+            out.push(self.parse_expr(a, off, t)?);
+        }
+        out.try_into()
+            .map_err(|_| self.err_at(a.pos, format!("attribute '{name}' needs 3 items")))
+    }
+
+    /// Optional keyword attribute among `choices`.
+    pub fn keyword<T: Copy>(
+        &self,
+        name: &str,
+        choices: &[(&str, T)],
+    ) -> Result<Option<T>, ModelError> {
+        let Some(a) = self.get(name) else {
+            return Ok(None);
+        };
+        let v = a.value.trim();
+        match choices.iter().find(|(k, _)| *k == v) {
+            Some(&(_, t)) => Ok(Some(t)),
+            None => {
+                let list = choices
+                    .iter()
+                    .map(|(k, _)| *k)
+                    .collect::<Vec<_>>()
+                    .join(", ");
+                Err(self.err_at(
+                    a.pos,
+                    format!("bad value '{v}' for '{name}' (expected {list})"),
+                ))
+            }
+        }
+    }
+    /// Required keyword attribute.
+    pub fn keyword_req<T: Copy>(&self, name: &str, choices: &[(&str, T)]) -> Result<T, ModelError> {
+        self.req(name)?;
+        self.keyword(name, choices)?
+            .ok_or_else(|| self.err(format!("missing required attribute '{name}'")))
+    }
+}
+
+/// A literal constant.
+pub(crate) fn constant(v: f64) -> Num {
+    Num {
+        expr: Expr::Num(v),
+        value: v,
+    }
+}

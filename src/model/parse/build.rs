@@ -1,0 +1,372 @@
+//! Second pass: build every element from its attributes, in file order, validating
+//! values and what expressions depend on.
+
+use super::attrs::{El, constant};
+use super::load::Loader;
+use super::orient::read_orientation;
+use super::validate::{Allowed, check_deps, check_inertia, check_mass};
+use super::xml::XElem;
+use crate::model::expr::{MarkerId, Scope};
+use crate::model::*;
+
+const SPRING_TYPES: &[(&str, SpringType)] = &[
+    ("translational", SpringType::Translational),
+    ("rotational", SpringType::Rotational),
+];
+
+impl<'a> Loader<'a> {
+    /// Build all elements (motions last: they refer to joints of any position).
+    pub(crate) fn build_all(&mut self) -> Result<(), ModelError> {
+        let root = self.root;
+        for x in &root.children {
+            let el = self.el(x);
+            match x.tag.as_str() {
+                "gravity" => {
+                    let g = el.vec3_req("value")?;
+                    self.model.gravity = g.v3();
+                    self.model.gravity_expr = Some(g);
+                }
+                "ground" => {
+                    for m in &x.children {
+                        let mk = self.marker(m, "ground", None)?;
+                        self.model.markers.push(mk);
+                    }
+                }
+                "body" => self.body(x)?,
+                "joint" => {
+                    let j = joint(&el)?;
+                    self.check_bodies(&el, j.i, j.j)?;
+                    self.model.joints.push(j);
+                }
+                "constraint" => {
+                    let function = el.expr_req("function")?;
+                    check_deps(&el, "function", &function, Allowed::Positions)?;
+                    let c = UserConstraint {
+                        name: x.label().into(),
+                        function,
+                        pos: x.pos,
+                    };
+                    self.model.constraints.push(c);
+                }
+                "spring_damper" => {
+                    let s = spring_damper(&el)?;
+                    self.model.spring_dampers.push(s);
+                }
+                "sforce" => {
+                    let function = el.expr_req("function")?;
+                    check_deps(&el, "function", &function, Allowed::Force)?;
+                    self.model.sforces.push(Sforce {
+                        name: x.label().into(),
+                        kind: el.keyword_req("type", SPRING_TYPES)?,
+                        i: marker_ref(&el, "i")?,
+                        j: marker_ref(&el, "j")?,
+                        function,
+                        pos: x.pos,
+                    });
+                }
+                "gforce" => {
+                    let force = el.expr_vec3("force")?;
+                    let torque = el.expr_vec3("torque")?;
+                    for (attr, es) in [("force", &force), ("torque", &torque)] {
+                        for e in es {
+                            check_deps(&el, attr, e, Allowed::Force)?;
+                        }
+                    }
+                    self.model.gforces.push(Gforce {
+                        name: x.label().into(),
+                        i: marker_ref(&el, "i")?,
+                        j: opt_marker_ref(&el, "j")?,
+                        frame: opt_marker_ref(&el, "frame")?,
+                        force,
+                        torque,
+                        pos: x.pos,
+                    });
+                }
+                "input" => {
+                    let input = Input {
+                        name: x.label().into(),
+                        start: el.num_or("start", 0.0)?,
+                        unit: el.get("unit").map(|a| a.value.clone()),
+                        pos: x.pos,
+                    };
+                    self.model.inputs.push(input);
+                }
+                "output" => {
+                    let function = el.expr_req("function")?;
+                    check_deps(&el, "function", &function, Allowed::Any)?;
+                    self.model.outputs.push(Output {
+                        name: x.label().into(),
+                        function,
+                        unit: el.get("unit").map(|a| a.value.clone()),
+                        pos: x.pos,
+                    });
+                }
+                "linearization" => self.linearization(x)?,
+                "experiment" => {
+                    let v = |n: &str| el.num(n).map(|o| o.map(|n| n.value));
+                    self.model.experiment = Experiment {
+                        start: v("start")?,
+                        stop: v("stop")?,
+                        step: v("step")?,
+                        tolerance: v("tolerance")?,
+                    };
+                }
+                "analysis" => {
+                    let b = el.keyword("static", &[("true", true), ("false", false)])?;
+                    self.model.static_analysis = b.unwrap_or(false);
+                }
+                _ => {}
+            }
+        }
+        for x in root.children.iter().filter(|x| x.tag == "motion") {
+            let m = self.motion(x)?;
+            self.model.motions.push(m);
+        }
+        Ok(())
+    }
+
+    fn body(&mut self, x: &'a XElem) -> Result<(), ModelError> {
+        let el = self.el(x);
+        let mass = el.num_req("mass")?;
+        check_mass(mass.value)
+            .map_err(|m| el.err_at(el.get("mass").map_or(x.pos, |a| a.pos), m))?;
+        el.req("inertia")?;
+        let inertia = el
+            .num_vec("inertia", &[3, 6])?
+            .unwrap_or(NumVec { items: vec![] });
+        check_inertia(&inertia.values())
+            .map_err(|m| el.err_at(el.get("inertia").map_or(x.pos, |a| a.pos), m))?;
+        let body = Body {
+            name: x.label().into(),
+            mass,
+            inertia,
+            position: el.vec3_req("position")?,
+            orientation: read_orientation(&el)?,
+            velocity: el.num_vec("velocity", &[3])?,
+            angular_velocity: el.num_vec("angular_velocity", &[3])?,
+            pos: x.pos,
+        };
+        let idx = self.model.bodies.len();
+        let name = body.name.clone();
+        self.model.bodies.push(body);
+        self.model.markers.push(Marker {
+            name: format!("{name}.cm"),
+            body: Some(idx),
+            position: NumVec {
+                items: vec![constant(0.0), constant(0.0), constant(0.0)],
+            },
+            orientation: Orientation::Identity,
+            pos: x.pos,
+        });
+        for m in &x.children {
+            let mk = self.marker(m, &name, Some(idx))?;
+            self.model.markers.push(mk);
+        }
+        Ok(())
+    }
+
+    fn marker(&self, x: &'a XElem, owner: &str, body: Option<usize>) -> Result<Marker, ModelError> {
+        let el = self.el(x);
+        Ok(Marker {
+            name: format!("{owner}.{}", x.label()),
+            body,
+            position: el.vec3_req("position")?,
+            orientation: read_orientation(&el)?,
+            pos: x.pos,
+        })
+    }
+
+    /// Joint markers must be on two different bodies (or one on ground).
+    fn check_bodies(&self, el: &El, i: MarkerId, j: MarkerId) -> Result<(), ModelError> {
+        let bi = self.scope.marker_body.get(i).copied().flatten();
+        let bj = self.scope.marker_body.get(j).copied().flatten();
+        if bi == bj {
+            let on = match bi.and_then(|b| self.scope.body_names.get(b)) {
+                Some(b) => format!("the same body '{b}'"),
+                None => "ground".to_string(),
+            };
+            return Err(el.err(format!("markers i and j are both on {on}")));
+        }
+        Ok(())
+    }
+
+    fn motion(&self, x: &'a XElem) -> Result<Motion, ModelError> {
+        let el = self.el(x);
+        let a = el.req("joint")?;
+        let name = a.value.trim();
+        let joint = self
+            .ns_joints
+            .get(name)
+            .ok_or_else(|| el.err_at(el.value_pos(a, 0), format!("unknown joint '{name}'")))?;
+        let dof = el.keyword_req(
+            "dof",
+            &[
+                ("rotation", MotionDof::Rotation),
+                ("translation", MotionDof::Translation),
+            ],
+        )?;
+        let kind = self.model.joints.get(joint).map(|j| j.kind);
+        let ok = matches!(
+            (dof, kind),
+            (
+                MotionDof::Rotation,
+                Some(JointType::Revolute | JointType::Cylindrical)
+            ) | (
+                MotionDof::Translation,
+                Some(JointType::Translational | JointType::Cylindrical)
+            )
+        );
+        if !ok {
+            let (need, dof_name) = match dof {
+                MotionDof::Rotation => ("revolute or cylindrical", "rotation"),
+                MotionDof::Translation => ("translational or cylindrical", "translation"),
+            };
+            let has = kind.map_or("unknown", joint_type_name);
+            let at = el.get("dof").map_or(x.pos, |a| a.pos);
+            return Err(el.err_at(
+                at,
+                format!("dof '{dof_name}' needs a {need} joint; joint '{name}' is {has}"),
+            ));
+        }
+        let function = el.expr_req("function")?;
+        check_deps(&el, "function", &function, Allowed::Time)?;
+        Ok(Motion {
+            name: x.label().into(),
+            joint,
+            dof,
+            function,
+            pos: x.pos,
+        })
+    }
+
+    fn linearization(&mut self, x: &'a XElem) -> Result<(), ModelError> {
+        for c in &x.children {
+            let el = self.el(c);
+            let function = el.expr_req("function")?;
+            let (name, pos) = (c.label().to_string(), c.pos);
+            if c.tag == "state" {
+                check_deps(&el, "function", &function, Allowed::Positions)?;
+                self.model.lin_states.push(LinState {
+                    name,
+                    function,
+                    pos,
+                });
+            } else {
+                check_deps(&el, "function", &function, Allowed::Velocities)?;
+                self.model.lin_velocities.push(LinVelocity {
+                    name,
+                    function,
+                    pos,
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+const JOINT_TYPES: &[(&str, JointType)] = &[
+    ("fixed", JointType::Fixed),
+    ("revolute", JointType::Revolute),
+    ("translational", JointType::Translational),
+    ("cylindrical", JointType::Cylindrical),
+    ("universal", JointType::Universal),
+    ("spherical", JointType::Spherical),
+    ("planar", JointType::Planar),
+];
+
+fn joint_type_name(t: JointType) -> &'static str {
+    JOINT_TYPES
+        .iter()
+        .find(|(_, k)| *k == t)
+        .map_or("?", |(n, _)| n)
+}
+
+fn joint(el: &El) -> Result<Joint, ModelError> {
+    let kind = el.keyword_req("type", JOINT_TYPES)?;
+    let rot = matches!(kind, JointType::Revolute | JointType::Cylindrical);
+    let tra = matches!(kind, JointType::Translational | JointType::Cylindrical);
+    for (attr, ok, types) in [
+        ("ic_angle", rot, "revolute and cylindrical"),
+        ("ic_angular_speed", rot, "revolute and cylindrical"),
+        ("ic_displacement", tra, "translational and cylindrical"),
+        ("ic_speed", tra, "translational and cylindrical"),
+    ] {
+        if let (Some(a), false) = (el.get(attr), ok) {
+            let msg = format!(
+                "attribute '{attr}' is not allowed on a {} joint (only {types})",
+                joint_type_name(kind)
+            );
+            return Err(el.err_at(a.pos, msg));
+        }
+    }
+    Ok(Joint {
+        name: el.x.label().into(),
+        kind,
+        i: marker_ref(el, "i")?,
+        j: marker_ref(el, "j")?,
+        ic_angle: el.num("ic_angle")?,
+        ic_angular_speed: el.num("ic_angular_speed")?,
+        ic_displacement: el.num("ic_displacement")?,
+        ic_speed: el.num("ic_speed")?,
+        pos: el.x.pos,
+    })
+}
+
+fn spring_damper(el: &El) -> Result<SpringDamper, ModelError> {
+    let kind = el.keyword_req("type", SPRING_TYPES)?;
+    let (len_attr, other) = match kind {
+        SpringType::Translational => ("length", "angle"),
+        SpringType::Rotational => ("angle", "length"),
+    };
+    if let Some(a) = el.get(other) {
+        let t = if kind == SpringType::Translational {
+            "translational"
+        } else {
+            "rotational"
+        };
+        let msg =
+            format!("attribute '{other}' is not allowed on a {t} spring_damper (use '{len_attr}')");
+        return Err(el.err_at(a.pos, msg));
+    }
+    let length = match kind {
+        SpringType::Translational => el.num_req("length")?,
+        SpringType::Rotational => el.num_or("angle", 0.0)?,
+    };
+    Ok(SpringDamper {
+        name: el.x.label().into(),
+        kind,
+        i: marker_ref(el, "i")?,
+        j: marker_ref(el, "j")?,
+        stiffness: el.num_req("stiffness")?,
+        damping: el.num_or("damping", 0.0)?,
+        length,
+        preload: el.num_or("preload", 0.0)?,
+        pos: el.x.pos,
+    })
+}
+
+/// A required marker reference.
+fn marker_ref(el: &El, attr: &str) -> Result<MarkerId, ModelError> {
+    el.req(attr)?;
+    opt_marker_ref(el, attr)?.ok_or_else(|| el.err(format!("missing required attribute '{attr}'")))
+}
+
+/// An optional marker reference (`body.marker`, `ground.marker`, or a body's name).
+fn opt_marker_ref(el: &El, attr: &str) -> Result<Option<MarkerId>, ModelError> {
+    let Some(a) = el.get(attr) else {
+        return Ok(None);
+    };
+    let name = a.value.trim();
+    let lead = a.value.len() - a.value.trim_start().len();
+    let hint = if name == "ground" {
+        " (ground has no cm marker: name one, ground.<marker>)"
+    } else {
+        ""
+    };
+    el.scope.marker(name).map(Some).ok_or_else(|| {
+        el.err_at(
+            el.value_pos(a, lead),
+            format!("unknown marker '{name}'{hint}"),
+        )
+    })
+}

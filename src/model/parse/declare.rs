@@ -1,0 +1,385 @@
+//! First pass: check every element's tag and attributes, declare every name (so that
+//! references may point forward), and number markers (each body's `cm` first).
+
+use super::attrs::El;
+use super::load::Loader;
+use super::names::{Namespace, invalid_name};
+use super::xml::XElem;
+use crate::model::ModelError;
+use crate::model::expr::{ElementRef, NameRef};
+
+/// Elements of the format that this version does not read yet.
+const UNSUPPORTED: &[&str] = &[
+    "differential",
+    "variable",
+    "bushing",
+    "rolling_wheel",
+    "knife_edge",
+    "velocity_constraint",
+];
+
+/// Allowed and required attributes of each supported element.
+pub(crate) fn schema(tag: &str) -> Option<(&'static [&'static str], &'static [&'static str])> {
+    Some(match tag {
+        "multibody" => (&["name", "version"], &["name", "version"]),
+        "parameter" => (
+            &["name", "value", "description", "unit"],
+            &["name", "value"],
+        ),
+        "gravity" => (&["value"], &["value"]),
+        "ground" | "linearization" => (&[], &[]),
+        "body" => (
+            &[
+                "name",
+                "mass",
+                "inertia",
+                "position",
+                "euler313",
+                "z_axis",
+                "x_axis",
+                "velocity",
+                "angular_velocity",
+            ],
+            &["name", "mass", "inertia", "position"],
+        ),
+        "marker" => (
+            &["name", "position", "euler313", "z_axis", "x_axis"],
+            &["name", "position"],
+        ),
+        "joint" => (
+            &[
+                "name",
+                "type",
+                "i",
+                "j",
+                "ic_angle",
+                "ic_angular_speed",
+                "ic_displacement",
+                "ic_speed",
+            ],
+            &["name", "type", "i", "j"],
+        ),
+        "motion" => (
+            &["name", "joint", "dof", "function"],
+            &["name", "joint", "dof", "function"],
+        ),
+        "constraint" | "state" | "velocity" => (&["name", "function"], &["name", "function"]),
+        "spring_damper" => (
+            &[
+                "name",
+                "type",
+                "i",
+                "j",
+                "stiffness",
+                "damping",
+                "length",
+                "angle",
+                "preload",
+            ],
+            &["name", "type", "i", "j", "stiffness"],
+        ),
+        "sforce" => (
+            &["name", "type", "i", "j", "function"],
+            &["name", "type", "i", "j", "function"],
+        ),
+        "gforce" => (
+            &["name", "i", "j", "frame", "force", "torque"],
+            &["name", "i"],
+        ),
+        "input" => (&["name", "start", "unit"], &["name"]),
+        "output" => (&["name", "function", "unit"], &["name", "function"]),
+        "experiment" => (&["start", "stop", "step", "tolerance"], &[]),
+        "analysis" => (&["static"], &[]),
+        _ => return None,
+    })
+}
+
+/// Which child elements an element may hold.
+fn children_allowed(tag: &str) -> &'static [&'static str] {
+    match tag {
+        "body" | "ground" => &["marker"],
+        "linearization" => &["state", "velocity"],
+        _ => &[],
+    }
+}
+
+impl<'a> Loader<'a> {
+    /// Check an element's tag, attributes and children's tags (recursively).
+    pub(crate) fn check_element(&self, x: &'a XElem, parent: &str) -> Result<(), ModelError> {
+        let el = self.el(x);
+        if UNSUPPORTED.contains(&x.tag.as_str()) {
+            return Err(el.err("element not supported yet"));
+        }
+        let allowed_here: &[&str] = if parent == "multibody" {
+            &[
+                "parameter",
+                "gravity",
+                "ground",
+                "body",
+                "joint",
+                "motion",
+                "constraint",
+                "spring_damper",
+                "sforce",
+                "gforce",
+                "input",
+                "output",
+                "linearization",
+                "experiment",
+                "analysis",
+            ]
+        } else {
+            children_allowed(parent)
+        };
+        let Some((allowed, required)) = schema(&x.tag) else {
+            return Err(el.err("unknown element"));
+        };
+        if !allowed_here.contains(&x.tag.as_str()) {
+            return Err(el.err(format!(
+                "element <{}> is not allowed inside <{parent}>",
+                x.tag
+            )));
+        }
+        el.check_attrs(allowed, required)?;
+        for c in &x.children {
+            self.check_element(c, &x.tag)?;
+        }
+        Ok(())
+    }
+
+    /// Check the `name` attribute of `x` and declare it in `ns`; returns the name.
+    fn declare(
+        &self,
+        ns: &mut Namespace,
+        x: &'a XElem,
+        kind: &str,
+        idx: usize,
+        is_marker: bool,
+    ) -> Result<String, ModelError> {
+        let el = self.el(x);
+        let a = el.req("name")?;
+        if let Some(msg) = invalid_name(&a.value, is_marker) {
+            return Err(el.err_at(a.pos, msg));
+        }
+        let full = match (is_marker, kind) {
+            (true, owner) => format!("{owner}.{}", a.value),
+            _ => a.value.clone(),
+        };
+        ns.declare(&full, idx, x.pos.line).map_err(|line| {
+            let what = if is_marker { "marker" } else { kind };
+            el.err_at(
+                a.pos,
+                format!(
+                    "duplicate {what} name '{}' (first defined at line {line})",
+                    a.value
+                ),
+            )
+        })?;
+        Ok(full)
+    }
+
+    /// Declare a bare name usable in expressions (parameters and inputs share these).
+    fn declare_bare(
+        &mut self,
+        x: &'a XElem,
+        kind: &'static str,
+        r: NameRef,
+    ) -> Result<(), ModelError> {
+        let mut tmp = Namespace::default();
+        let name = self.declare(&mut tmp, x, kind, 0, false)?;
+        if let Some(&(prev, line)) = self.scope.names.get(&name) {
+            let prev_kind = match prev {
+                NameRef::Param(_) => "parameter",
+                NameRef::Input(_) => "input",
+                NameRef::Variable(_) => "variable",
+                NameRef::Diff(_) => "differential",
+            };
+            let el = self.el(x);
+            let at = el.get("name").map_or(x.pos, |a| a.pos);
+            let msg = if prev_kind == kind {
+                format!("duplicate {kind} name '{name}' (first defined at line {line})")
+            } else {
+                format!("name '{name}' is already used by {prev_kind} at line {line}")
+            };
+            return Err(el.err_at(at, msg));
+        }
+        self.scope.names.insert(name, (r, x.pos.line));
+        Ok(())
+    }
+
+    /// Declare an element that load functions (`fx(name)` ...) can name.
+    fn declare_element(
+        &mut self,
+        x: &'a XElem,
+        kind: &'static str,
+        r: ElementRef,
+        idx: usize,
+    ) -> Result<(), ModelError> {
+        let mut ns = std::mem::take(self.namespace(kind));
+        let res = self.declare(&mut ns, x, kind, idx, false);
+        *self.namespace(kind) = ns;
+        let name = res?;
+        if let Some(&(_, prev, line)) = self.scope.elements.get(&name) {
+            let el = self.el(x);
+            let at = el.get("name").map_or(x.pos, |a| a.pos);
+            return Err(el.err_at(
+                at,
+                format!("name '{name}' is already used by {prev} at line {line} (load functions need unique names)"),
+            ));
+        }
+        self.scope.elements.insert(name, (r, kind, x.pos.line));
+        Ok(())
+    }
+
+    fn declare_markers(
+        &mut self,
+        x: &'a XElem,
+        owner: &str,
+        body: Option<usize>,
+    ) -> Result<(), ModelError> {
+        for m in &x.children {
+            let idx = self.scope.marker_body.len();
+            let mut ns = std::mem::take(&mut self.ns_markers);
+            let res = self.declare(&mut ns, m, owner, idx, true);
+            self.ns_markers = ns;
+            let full = res?;
+            self.scope.markers.insert(full, idx);
+            self.scope.marker_body.push(body);
+        }
+        Ok(())
+    }
+
+    /// Reject a second occurrence of a once-only element.
+    fn once(&mut self, x: &'a XElem) -> Result<(), ModelError> {
+        if let Some(line) = self.singletons.get(&x.tag) {
+            let msg = format!(
+                "only one <{}> element is allowed (first at line {line})",
+                x.tag
+            );
+            return Err(self.el(x).err(msg));
+        }
+        self.singletons.insert(x.tag.clone(), x.pos.line);
+        Ok(())
+    }
+
+    /// The first pass over the root's children.
+    pub(crate) fn declare_all(&mut self) -> Result<(), ModelError> {
+        let root = self.root;
+        let mut n = Counts::default();
+        for x in &root.children {
+            self.check_element(x, "multibody")?;
+            match x.tag.as_str() {
+                "parameter" => {
+                    self.declare_bare(x, "parameter", NameRef::Param(n.params))?;
+                    n.params += 1;
+                }
+                "input" => {
+                    self.declare_bare(x, "input", NameRef::Input(n.inputs))?;
+                    n.inputs += 1;
+                }
+                "body" => {
+                    let mut ns = std::mem::take(&mut self.ns_bodies);
+                    let res = self.declare(&mut ns, x, "body", n.bodies, false);
+                    self.ns_bodies = ns;
+                    let name = res?;
+                    let cm = self.scope.marker_body.len();
+                    self.scope.marker_body.push(Some(n.bodies));
+                    self.scope.markers.insert(format!("{name}.cm"), cm);
+                    self.scope.body_cm.insert(name.clone(), cm);
+                    self.scope.body_names.push(name.clone());
+                    self.declare_markers(x, &name, Some(n.bodies))?;
+                    n.bodies += 1;
+                }
+                "ground" => {
+                    self.once(x)?;
+                    self.declare_markers(x, "ground", None)?;
+                }
+                "joint" => {
+                    self.declare_element(x, "joint", ElementRef::Joint(n.joints), n.joints)?;
+                    n.joints += 1;
+                }
+                "motion" => {
+                    self.declare_element(x, "motion", ElementRef::Motion(n.motions), n.motions)?;
+                    n.motions += 1;
+                }
+                "constraint" => {
+                    let r = ElementRef::Constraint(n.constraints);
+                    self.declare_element(x, "constraint", r, n.constraints)?;
+                    n.constraints += 1;
+                }
+                "spring_damper" => {
+                    let r = ElementRef::SpringDamper(n.springs);
+                    self.declare_element(x, "force", r, n.forces)?;
+                    n.springs += 1;
+                    n.forces += 1;
+                }
+                "sforce" => {
+                    self.declare_element(x, "force", ElementRef::Sforce(n.sforces), n.forces)?;
+                    n.sforces += 1;
+                    n.forces += 1;
+                }
+                "gforce" => {
+                    self.declare_element(x, "force", ElementRef::Gforce(n.gforces), n.forces)?;
+                    n.gforces += 1;
+                    n.forces += 1;
+                }
+                "output" => {
+                    let mut ns = std::mem::take(&mut self.ns_outputs);
+                    let res = self.declare(&mut ns, x, "output", n.outputs, false);
+                    self.ns_outputs = ns;
+                    res?;
+                    n.outputs += 1;
+                }
+                "linearization" => {
+                    self.once(x)?;
+                    for c in &x.children {
+                        let mut ns = std::mem::take(&mut self.ns_lin);
+                        let res = self.declare(&mut ns, c, "linearization state", n.lin, false);
+                        self.ns_lin = ns;
+                        res?;
+                        n.lin += 1;
+                    }
+                }
+                "gravity" | "experiment" | "analysis" => self.once(x)?,
+                _ => {}
+            }
+        }
+        Ok(())
+    }
+
+    /// The namespace of a kind of element with a load-function name.
+    fn namespace(&mut self, kind: &str) -> &mut Namespace {
+        match kind {
+            "joint" => &mut self.ns_joints,
+            "motion" => &mut self.ns_motions,
+            "constraint" => &mut self.ns_constraints,
+            _ => &mut self.ns_forces,
+        }
+    }
+
+    /// An attribute reader for `x` with the current scope and parameter values.
+    pub(crate) fn el(&self, x: &'a XElem) -> El<'_> {
+        El {
+            x,
+            src: self.src,
+            scope: &self.scope,
+            params: &self.params,
+        }
+    }
+}
+
+#[derive(Default)]
+struct Counts {
+    params: usize,
+    inputs: usize,
+    bodies: usize,
+    joints: usize,
+    motions: usize,
+    constraints: usize,
+    springs: usize,
+    sforces: usize,
+    gforces: usize,
+    forces: usize,
+    outputs: usize,
+    lin: usize,
+}

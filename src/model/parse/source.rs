@@ -1,0 +1,59 @@
+//! The model text with its file label: byte offsets to 1-based line:column, and errors.
+
+use crate::model::{ModelError, SrcPos};
+
+/// The text being read and where it came from.
+pub(crate) struct Source<'t> {
+    pub file: String,
+    pub text: &'t str,
+    line_starts: Vec<usize>,
+}
+
+impl<'t> Source<'t> {
+    pub fn new(text: &'t str, file: &str) -> Self {
+        let mut line_starts = vec![0];
+        line_starts.extend(text.match_indices('\n').map(|(i, _)| i + 1));
+        Source {
+            file: file.to_string(),
+            text,
+            line_starts,
+        }
+    }
+
+    /// Line and column (in characters, both 1-based) of byte offset `off`.
+    pub fn pos(&self, off: usize) -> SrcPos {
+        let off = off.min(self.text.len());
+        let line = self.line_starts.partition_point(|&s| s <= off).max(1);
+        let start = self.line_starts[line - 1];
+        let col = self
+            .text
+            .get(start..off)
+            .map_or(off - start, |s| s.chars().count())
+            + 1;
+        SrcPos { line, col }
+    }
+
+    /// Byte offset of `s` in the text when `s` borrows from it.
+    pub fn offset_of(&self, s: &str) -> Option<usize> {
+        let base = self.text.as_ptr() as usize;
+        let p = s.as_ptr() as usize;
+        (p >= base && p + s.len() <= base + self.text.len()).then(|| p - base)
+    }
+
+    /// A located error.
+    pub fn error(
+        &self,
+        pos: SrcPos,
+        element: &str,
+        name: &str,
+        msg: impl Into<String>,
+    ) -> ModelError {
+        ModelError {
+            file: self.file.clone(),
+            pos,
+            element: element.to_string(),
+            name: name.to_string(),
+            msg: msg.into(),
+        }
+    }
+}

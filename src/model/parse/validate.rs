@@ -1,0 +1,104 @@
+//! Checks on values and on what expressions depend on.
+
+use super::attrs::El;
+use crate::model::ModelError;
+use crate::model::expr::{self, Expr};
+
+/// A mass must be positive.
+pub(crate) fn check_mass(m: f64) -> Result<(), String> {
+    if m > 0.0 {
+        Ok(())
+    } else {
+        Err(format!("mass must be positive (got {m})"))
+    }
+}
+
+/// The inertia matrix `[[Ixx,Ixy,Ixz],[Ixy,Iyy,Iyz],[Ixz,Iyz,Izz]]` must be positive
+/// definite (checked by Cholesky factorization); `v` holds 3 or 6 entries.
+pub(crate) fn check_inertia(v: &[f64]) -> Result<(), String> {
+    let g = |k: usize| v.get(k).copied().unwrap_or(0.0);
+    let (xy, xz, yz) = if v.len() == 6 {
+        (g(3), g(4), g(5))
+    } else {
+        (0.0, 0.0, 0.0)
+    };
+    let a = [[g(0), xy, xz], [xy, g(1), yz], [xz, yz, g(2)]];
+    let mut l = [[0.0f64; 3]; 3];
+    for i in 0..3 {
+        for j in 0..=i {
+            let s: f64 = a[i][j] - (0..j).map(|k| l[i][k] * l[j][k]).sum::<f64>();
+            if i == j {
+                if s.is_nan() || s <= 0.0 {
+                    return Err("inertia is not positive definite".into());
+                }
+                l[i][i] = s.sqrt();
+            } else {
+                l[i][j] = s / l[j][j];
+            }
+        }
+    }
+    Ok(())
+}
+
+/// What an expression attribute may depend on.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Allowed {
+    /// Time and parameters (motion functions).
+    Time,
+    /// Positions, time, parameters (constraints, linearization states).
+    Positions,
+    /// Positions, velocities, time, parameters (linearization velocities).
+    Velocities,
+    /// Forces: anything but accelerations and element loads.
+    Force,
+    /// Outputs: anything.
+    Any,
+}
+
+/// Check that expression `e` of attribute `attr` uses only what `allowed` permits.
+pub(crate) fn check_deps(
+    el: &El,
+    attr: &str,
+    e: &Expr,
+    allowed: Allowed,
+) -> Result<(), ModelError> {
+    let d = expr::deps(e);
+    let at = el.get(attr).map_or(el.x.pos, |a| a.pos);
+    if allowed == Allowed::Force {
+        if d.level >= 2 || !d.loads.is_empty() {
+            return Err(el.err_at(
+                at,
+                "forces depending on accelerations or loads are not supported yet",
+            ));
+        }
+        return Ok(());
+    }
+    if allowed == Allowed::Any {
+        return Ok(());
+    }
+    let max_level = if allowed == Allowed::Velocities { 1 } else { 0 };
+    let used = if allowed == Allowed::Time && !d.markers.is_empty() {
+        Some("marker measures")
+    } else if d.level > max_level {
+        Some(if d.level >= 2 {
+            "accelerations"
+        } else {
+            "velocities"
+        })
+    } else if !d.inputs.is_empty() {
+        Some("inputs")
+    } else if !d.loads.is_empty() {
+        Some("element loads")
+    } else if !(d.variables.is_empty() && d.diffs.is_empty() && d.diff_dots.is_empty()) {
+        Some("user variables or differentials")
+    } else {
+        None
+    };
+    let Some(used) = used else { return Ok(()) };
+    let may = match allowed {
+        Allowed::Time => "time and parameters",
+        Allowed::Velocities => "positions, velocities, time and parameters",
+        _ => "positions, time and parameters",
+    };
+    Err(el.err_at(at, format!("'{attr}' may use only {may} (it uses {used})")))
+}
