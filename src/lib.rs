@@ -7,4 +7,5 @@ pub mod ad;
 pub mod cli;
 pub mod dae;
 pub mod geom;
+pub mod mechanics;
 pub mod model;

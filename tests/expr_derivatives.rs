@@ -51,35 +51,20 @@ impl<T: Real> ExprEnv<T> for Arm<T> {
     }
     fn pose(&self, m: MarkerId) -> Pose<T> {
         if m == 1 {
-            return Pose {
-                p: V3::zero(),
-                r: M3::identity(),
-            };
+            return Pose { p: V3::zero(), r: M3::identity() };
         }
         let r = rot_z(self.q);
-        Pose {
-            p: r.col(0).mul_s(self.r),
-            r,
-        }
+        Pose { p: r.col(0).mul_s(self.r), r }
     }
     fn twist(&self, m: MarkerId) -> Twist<T> {
         if m == 1 {
-            return Twist {
-                v: V3::zero(),
-                w: V3::zero(),
-            };
+            return Twist { v: V3::zero(), w: V3::zero() };
         }
         let w = V3::new(T::zero(), T::zero(), self.qd);
-        Twist {
-            v: w.cross(&self.pose(m).p),
-            w,
-        }
+        Twist { v: w.cross(&self.pose(m).p), w }
     }
     fn accel(&self, _: MarkerId) -> Twist<T> {
-        Twist {
-            v: V3::zero(),
-            w: V3::zero(),
-        }
+        Twist { v: V3::zero(), w: V3::zero() }
     }
     fn load(&self, _: LoadFn, _: ElementRef) -> T {
         T::zero()
@@ -90,11 +75,7 @@ impl<T: Real> ExprEnv<T> for Arm<T> {
 fn arm_angle_distance_and_tip_speed_with_exact_partials() {
     type D = Dual<f64, 3>;
     // Seeded on q, r, q̇.
-    let env = Arm {
-        q: D::var(0.3, 0),
-        r: D::var(1.5, 1),
-        qd: D::var(2.0, 2),
-    };
+    let env = Arm { q: D::var(0.3, 0), r: D::var(1.5, 1), qd: D::var(2.0, 2) };
     let e = parse("k * az(arm, ground.O) + dm(arm) + vm(arm)", &OneBody).unwrap();
     let d = deps(&e);
     assert_eq!((d.markers, d.level, d.params), (vec![0, 1], 1, vec![0]));
@@ -106,15 +87,9 @@ fn arm_angle_distance_and_tip_speed_with_exact_partials() {
         assert!((got - want).abs() < 1e-12, "{got} vs {want}");
     }
     assert!(!is_constant(&e));
-    assert_eq!(
-        const_value(&parse("k^2 + 1", &OneBody).unwrap(), &[3.0]),
-        10.0
-    );
+    assert_eq!(const_value(&parse("k^2 + 1", &OneBody).unwrap(), &[3.0]), 10.0);
     assert_eq!(
         parse("az(arm, pin)", &OneBody).unwrap_err(),
-        ExprError {
-            offset: 8,
-            msg: "unknown marker 'pin'".into()
-        }
+        ExprError { offset: 8, msg: "unknown marker 'pin'".into() }
     );
 }

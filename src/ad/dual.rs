@@ -109,10 +109,7 @@ impl<T: Real, const N: usize> Neg for Dual<T, N> {
 
 impl<T: Real, const N: usize> Real for Dual<T, N> {
     fn cst(v: f64) -> Self {
-        Dual {
-            v: T::cst(v),
-            d: [T::zero(); N],
-        }
+        Dual { v: T::cst(v), d: [T::zero(); N] }
     }
     fn val(&self) -> f64 {
         self.v.val()
@@ -122,10 +119,7 @@ impl<T: Real, const N: usize> Real for Dual<T, N> {
         for x in d.iter_mut() {
             *x = x.scale(s);
         }
-        Dual {
-            v: self.v.scale(s),
-            d,
-        }
+        Dual { v: self.v.scale(s), d }
     }
     fn sin(self) -> Self {
         self.chain(self.v.sin(), self.v.cos())
@@ -138,16 +132,10 @@ impl<T: Real, const N: usize> Real for Dual<T, N> {
         self.chain(t, T::one() + t * t)
     }
     fn asin(self) -> Self {
-        self.chain(
-            self.v.asin(),
-            T::one() / (T::one() - self.v * self.v).sqrt(),
-        )
+        self.chain(self.v.asin(), T::one() / (T::one() - self.v * self.v).sqrt())
     }
     fn acos(self) -> Self {
-        self.chain(
-            self.v.acos(),
-            -T::one() / (T::one() - self.v * self.v).sqrt(),
-        )
+        self.chain(self.v.acos(), -T::one() / (T::one() - self.v * self.v).sqrt())
     }
     fn atan(self) -> Self {
         self.chain(self.v.atan(), T::one() / (T::one() + self.v * self.v))
@@ -159,10 +147,7 @@ impl<T: Real, const N: usize> Real for Dual<T, N> {
         for (k, e) in d.iter_mut().enumerate() {
             *e = (x.v * self.d[k] - self.v * x.d[k]) / r2;
         }
-        Dual {
-            v: self.v.atan2(x.v),
-            d,
-        }
+        Dual { v: self.v.atan2(x.v), d }
     }
     fn sinh(self) -> Self {
         self.chain(self.v.sinh(), self.v.cosh())
@@ -211,14 +196,8 @@ mod tests {
         // f(x, y) = x^2 y ; f_x = 2xy, f_xy = 2x, f_xx = 2y
         type D1 = Dual<f64, 2>;
         type D2 = Dual<D1, 2>;
-        let x = D2 {
-            v: D1::var(3.0, 0),
-            d: [D1::one(), D1::zero()],
-        };
-        let y = D2 {
-            v: D1::var(5.0, 1),
-            d: [D1::zero(), D1::one()],
-        };
+        let x = D2 { v: D1::var(3.0, 0), d: [D1::one(), D1::zero()] };
+        let y = D2 { v: D1::var(5.0, 1), d: [D1::zero(), D1::one()] };
         let f = x * x * y;
         assert_eq!(f.v.v, 45.0);
         assert_eq!(f.d[0].v, 30.0);

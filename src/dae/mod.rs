@@ -1,6 +1,11 @@
 //! The DAE layer: residual and sparse Jacobians of the equations of motion (Eq. 13a–13e),
-//! initialization (assembly), and the index-3 integrator.
+//! initialization (assembly), and the integrator (Radau IIA on the stabilized system).
 
+pub mod equations;
+pub mod init;
+pub mod radau;
+mod radau_tableau;
 mod simulator;
+pub mod sparse;
 
 pub use simulator::{BodyState, EngineError, SimOptions, Simulator};

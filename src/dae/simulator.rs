@@ -1,6 +1,16 @@
 //! Public face of the engine: build, initialize, advance, read results.
 
+use super::equations::{self, Layout};
+use super::init;
+use super::radau::{DaeProblem, Radau, Stats};
+use super::sparse::{SparseLu, Triplets};
+use crate::geom::{M3, V3, rot313};
+use crate::mechanics::System;
+use crate::mechanics::body::{NQ, body_frame};
+use crate::mechanics::local::LocalCtx;
+use crate::mechanics::system::{FAR_FROM_SINGULAR, rebased_reference};
 use crate::model::Model;
+use crate::model::expr::{ElementRef, LoadFn, eval};
 
 /// Engine failure (assembly, integration, evaluation).
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -10,7 +20,8 @@ pub struct EngineError(pub String);
 /// Integrator options.
 #[derive(Clone, Copy, Debug)]
 pub struct SimOptions {
-    /// Local error tolerance (relative and absolute) of positions and velocities.
+    /// Local error tolerance (relative and absolute) of positions and velocities; also
+    /// the assembly tolerance of the constraints.
     pub tol: f64,
     /// Largest step the integrator may take (None: unlimited).
     pub max_step: Option<f64>,
@@ -35,54 +46,322 @@ pub struct BodyState {
     pub angular_velocity: [f64; 3],
 }
 
+/// The multibody DAE handed to the integrator.
+struct MultibodyDae {
+    sys: System,
+    lay: Layout,
+    inputs: Vec<f64>,
+}
+
+impl DaeProblem for MultibodyDae {
+    fn dim(&self) -> usize {
+        self.lay.dim()
+    }
+    fn rhs(&mut self, t: f64, y: &[f64], f: &mut [f64]) -> Result<(), String> {
+        equations::rhs(&self.sys, self.lay, t, y, &self.inputs, f);
+        if f.iter().all(|v| v.is_finite()) { Ok(()) } else { Err("non-finite equations".into()) }
+    }
+    fn jacobian(&mut self, t: f64, y: &[f64], j: &mut Triplets) -> Result<(), String> {
+        equations::jacobian(&self.sys, self.lay, t, y, &self.inputs, j);
+        Ok(())
+    }
+    fn mass(&self, m: &mut Triplets) {
+        equations::mass_matrix(&self.sys, self.lay, m);
+    }
+    fn index(&self) -> Vec<u8> {
+        (0..self.lay.dim()).map(|i| if i < 2 * self.lay.n { 0 } else { 2 }).collect()
+    }
+    fn accepted(&mut self, t: f64, y: &mut [f64]) -> bool {
+        let mut changed = false;
+        for b in 0..self.sys.nb() {
+            let o = NQ * b;
+            let (th, psi, phi) = (y[o + 4], y[o + 3], y[o + 5]);
+            let near_singular = th.sin().abs() < 0.3;
+            let wrapped = psi.abs() > std::f64::consts::PI || phi.abs() > std::f64::consts::PI;
+            if near_singular || wrapped {
+                // Re-base: choose R0 so the body's current orientation has angles (0, π/2, 0).
+                let a = M3::cst(&self.sys.r0[b]).mm(&rot313(psi, th, phi)).val();
+                self.sys.r0[b] = rebased_reference(&a);
+                y[o + 3..o + 6].copy_from_slice(&FAR_FROM_SINGULAR);
+                changed = true;
+            }
+        }
+        let n = self.lay.n;
+        for k in 0..self.sys.forces.len() {
+            let el = &self.sys.forces[k];
+            let ql = crate::mechanics::kernels::gather(&el.bodies, &y[..n]);
+            let ctx = LocalCtx::new(&self.sys, &el.bodies, &ql, &[], &[], t, &self.inputs);
+            if let Some(a) = el.angle(&ctx) {
+                self.sys.forces[k].angle_ref = a;
+            }
+        }
+        changed
+    }
+}
+
 /// A running simulation of one model.
 pub struct Simulator {
-    _private: (),
+    dae: MultibodyDae,
+    radau: Radau,
+    acc_lu: SparseLu,
+    /// Accelerations and multipliers at the current time (None: not yet computed).
+    acc: Option<(Vec<f64>, Vec<f64>)>,
 }
 
 impl Simulator {
     /// Build the equations and initialize at `t0` (assembly, consistent velocities,
     /// accelerations and multipliers).
     pub fn new(model: &Model, opts: SimOptions, t0: f64) -> Result<Simulator, EngineError> {
-        let _ = (model, opts, t0);
-        Err(EngineError("engine not implemented".into()))
+        let sys = System::from_model(model).map_err(EngineError)?;
+        let inputs: Vec<f64> = model.inputs.iter().map(|i| i.start.value).collect();
+        let lay = Layout { n: sys.n(), m: sys.m };
+        let mut q = sys.q_init.clone();
+        let mut u = sys.u_init.clone();
+        let assembly_tol = (opts.tol * 1e-3).max(1e-14);
+        init::assemble_positions(&sys, &mut q, t0, &inputs, assembly_tol).map_err(EngineError)?;
+        init::assemble_velocities(&sys, &q, &mut u, t0, &inputs).map_err(EngineError)?;
+        let mut acc_lu = SparseLu::new();
+        let (udot, lam) = init::accelerations(&sys, &q, &u, t0, &inputs, &mut acc_lu).map_err(EngineError)?;
+        let mut y = vec![0.0; lay.dim()];
+        y[..lay.n].copy_from_slice(&q);
+        y[lay.u()..lay.u() + lay.n].copy_from_slice(&u);
+        y[lay.lam()..lay.lam() + lay.m].copy_from_slice(&lam);
+        let mut dae = MultibodyDae { sys, lay, inputs };
+        dae.accepted(t0, &mut y);
+        let mut radau = Radau::new(&dae, t0, y, opts.tol);
+        if let Some(h) = opts.max_step {
+            radau.max_step = h;
+        }
+        Ok(Simulator { dae, radau, acc_lu, acc: Some((udot, lam)) })
     }
+
     /// Current time.
     pub fn time(&self) -> f64 {
-        0.0
+        self.radau.t
     }
+
     /// Integrate to `t_end` exactly (the last step lands on it).
     pub fn advance(&mut self, t_end: f64) -> Result<(), EngineError> {
-        let _ = t_end;
-        Err(EngineError("engine not implemented".into()))
+        if t_end < self.radau.t {
+            return Err(EngineError(format!("cannot integrate backwards from {} to {t_end}", self.radau.t)));
+        }
+        self.acc = None;
+        self.radau.advance(&mut self.dae, t_end).map_err(EngineError)
     }
+
+    /// Integrator statistics so far.
+    pub fn stats(&self) -> Stats {
+        self.radau.stats
+    }
+
+    fn q(&self) -> &[f64] {
+        &self.radau.y[..self.dae.lay.n]
+    }
+
+    fn u(&self) -> &[f64] {
+        let l = self.dae.lay;
+        &self.radau.y[l.u()..l.u() + l.n]
+    }
+
+    /// Accelerations u̇ and multipliers λ at the current time (Eq. 1c–1d).
+    pub fn accelerations(&mut self) -> Result<(Vec<f64>, Vec<f64>), EngineError> {
+        if self.acc.is_none() {
+            let (q, u) = (self.q().to_vec(), self.u().to_vec());
+            let s = &self.dae;
+            self.acc = Some(
+                init::accelerations(&s.sys, &q, &u, self.radau.t, &s.inputs, &mut self.acc_lu).map_err(EngineError)?,
+            );
+        }
+        Ok(self.acc.clone().expect("just computed"))
+    }
+
     /// Names of the model's `<output>`s, in order.
     pub fn output_names(&self) -> Vec<String> {
-        vec![]
+        self.dae.sys.output_names.clone()
     }
+
     /// Values of the `<output>`s at the current time.
     pub fn outputs(&mut self) -> Result<Vec<f64>, EngineError> {
-        Err(EngineError("engine not implemented".into()))
+        let (udot, lam) = self.accelerations()?;
+        let sys = &self.dae.sys;
+        let ids: Vec<usize> = (0..sys.nb()).collect();
+        let ctx_loads = |f: LoadFn, e: ElementRef| -> f64 {
+            self.element_load(e, &lam).map_or(f64::NAN, |(fo, to)| pick(f, fo, to))
+        };
+        let mut ctx = LocalCtx::new(sys, &ids, self.q(), self.u(), &udot, self.radau.t, &self.dae.inputs);
+        ctx.loads = Some(&ctx_loads);
+        Ok(sys.outputs.iter().map(|e| eval(e, &ctx)).collect())
     }
+
+    /// Force and torque (ground; torque about the i marker origin) that an element
+    /// applies on its i marker.
+    fn element_load(&self, e: ElementRef, lam: &[f64]) -> Option<([f64; 3], [f64; 3])> {
+        let m = self.dae_model_counts();
+        let sys = &self.dae.sys;
+        let (q, u) = (self.q(), self.u());
+        let ids: Vec<usize> = (0..sys.nb()).collect();
+        let ctx = LocalCtx::new(sys, &ids, q, u, &[], self.radau.t, &self.dae.inputs);
+        let fidx = match e {
+            ElementRef::SpringDamper(k) => Some(k),
+            ElementRef::Sforce(k) => Some(m.1 + k),
+            ElementRef::Gforce(k) => Some(m.1 + m.2 + k),
+            _ => None,
+        };
+        if let Some(k) = fidx {
+            let l = sys.forces.get(k)?.load(&ctx);
+            return Some((l.force.val(), l.torque.val()));
+        }
+        let cidx = match e {
+            ElementRef::Joint(k) => k,
+            ElementRef::Motion(k) => m.0 + k,
+            ElementRef::Constraint(k) => m.0 + m.3 + k,
+            _ => return None,
+        };
+        let el = sys.constraints.get(cidx)?;
+        let f = crate::mechanics::kernels::constraint_first(sys, el, q, self.radau.t, &self.dae.inputs);
+        let nql = NQ * el.bodies.len();
+        let mut genf = vec![0.0; nql];
+        for e in 0..el.neq {
+            let p = equations::p_row(&el.bodies, q, &f.cq[e * nql..(e + 1) * nql]);
+            for a in 0..nql {
+                genf[a] -= p[a] * lam[el.row + e];
+            }
+        }
+        let (mi, mj) = match &el.kind {
+            crate::mechanics::constraints::ConstraintKind::Joint { i, j, .. }
+            | crate::mechanics::constraints::ConstraintKind::Rotation { i, j, .. }
+            | crate::mechanics::constraints::ConstraintKind::Translation { i, j, .. } => (*i, Some(*j)),
+            crate::mechanics::constraints::ConstraintKind::User { .. } => return None,
+        };
+        let pi = ctx_pose(&ctx, mi);
+        // Reaction on a body, moved to the point p_i.
+        let on_body = |b: usize| -> ([f64; 3], [f64; 3]) {
+            let k = el.bodies.iter().position(|&x| x == b).expect("element body");
+            let (r, a) = body_frame(&q[NQ * b..NQ * b + NQ], &sys.r0[b]);
+            let fo = V3([genf[NQ * k], genf[NQ * k + 1], genf[NQ * k + 2]]);
+            let tc = a.mv(&V3([genf[NQ * k + 3], genf[NQ * k + 4], genf[NQ * k + 5]]));
+            let ti = tc - (pi - r).cross(&fo);
+            (fo.0, ti.0)
+        };
+        match (sys.markers[mi].body, mj.and_then(|j| sys.markers[j].body)) {
+            (Some(b), _) => Some(on_body(b)),
+            (None, Some(b)) => {
+                let (fo, to) = on_body(b);
+                Some((fo.map(|x| -x), to.map(|x| -x)))
+            }
+            _ => None,
+        }
+    }
+
+    fn dae_model_counts(&self) -> (usize, usize, usize, usize) {
+        let s = &self.dae.sys;
+        let nj = s
+            .constraints
+            .iter()
+            .filter(|c| matches!(c.kind, crate::mechanics::constraints::ConstraintKind::Joint { .. }))
+            .count();
+        let nsd = s
+            .forces
+            .iter()
+            .filter(|f| matches!(f.kind, crate::mechanics::forces::ForceKind::SpringDamper { .. }))
+            .count();
+        let nsf =
+            s.forces.iter().filter(|f| matches!(f.kind, crate::mechanics::forces::ForceKind::Sforce { .. })).count();
+        let nmo = s
+            .constraints
+            .iter()
+            .filter(|c| {
+                matches!(
+                    c.kind,
+                    crate::mechanics::constraints::ConstraintKind::Rotation { .. }
+                        | crate::mechanics::constraints::ConstraintKind::Translation { .. }
+                )
+            })
+            .count();
+        (nj, nsd, nsf, nmo)
+    }
+
     /// Largest |C_i(q, t)| over the holonomic constraints at the current time.
     pub fn constraint_residual(&self) -> f64 {
-        f64::NAN
+        let s = &self.dae.sys;
+        s.constraints
+            .iter()
+            .flat_map(|el| {
+                crate::mechanics::kernels::constraint_values(s, el, self.q(), self.radau.t, &self.dae.inputs)
+            })
+            .fold(0.0, |a: f64, v| a.max(v.abs()))
     }
+
     /// State of body `b` (model order).
     pub fn body_state(&self, b: usize) -> BodyState {
-        let _ = b;
-        BodyState { position: [0.0; 3], rotation: [[0.0; 3]; 3], velocity: [0.0; 3], angular_velocity: [0.0; 3] }
+        let o = NQ * b;
+        let (r, a) = body_frame(&self.q()[o..o + NQ], &self.dae.sys.r0[b]);
+        let u = self.u();
+        let w = a.mv(&V3([u[o + 3], u[o + 4], u[o + 5]]));
+        BodyState { position: r.0, rotation: a.0, velocity: [u[o], u[o + 1], u[o + 2]], angular_velocity: w.0 }
     }
+
     /// Kinetic + gravitational potential + spring potential energy.
     pub fn mechanical_energy(&self) -> f64 {
-        f64::NAN
+        let s = &self.dae.sys;
+        let (q, u) = (self.q(), self.u());
+        let mut e = 0.0;
+        for (b, body) in s.bodies.iter().enumerate() {
+            let o = NQ * b;
+            let v = &u[o..o + 3];
+            let w = V3([u[o + 3], u[o + 4], u[o + 5]]);
+            let jw = M3::cst(&body.inertia).mv(&w);
+            e += 0.5 * body.mass * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) + 0.5 * w.dot(&jw);
+            e -= body.mass * (0..3).map(|c| s.gravity[c] * q[o + c]).sum::<f64>();
+        }
+        for el in &s.forces {
+            let ql = crate::mechanics::kernels::gather(&el.bodies, q);
+            let ul = crate::mechanics::kernels::gather(&el.bodies, u);
+            let ctx = LocalCtx::new(s, &el.bodies, &ql, &ul, &[], self.radau.t, &self.dae.inputs);
+            e += el.potential(&ctx);
+        }
+        e
     }
-    /// Names of every coordinate q and velocity u (`body.x`, ..., `body.wx`, ...).
+
+    /// Names of every coordinate q and velocity u (`body.x`, ..., `body.wz`).
     pub fn state_names(&self) -> Vec<String> {
-        vec![]
+        let qn = ["x", "y", "z", "psi", "theta", "phi"];
+        let un = ["vx", "vy", "vz", "wx", "wy", "wz"];
+        let s = &self.dae.sys;
+        let mut v: Vec<String> =
+            s.bodies.iter().flat_map(|b| qn.iter().map(move |c| format!("{}.{c}", b.name))).collect();
+        v.extend(s.bodies.iter().flat_map(|b| un.iter().map(move |c| format!("{}.{c}", b.name))));
+        v
     }
-    /// Current q and u, in the order of [`Simulator::state_names`].
+
+    /// Current q and u, in the order of [`Simulator::state_names`]. Angles are relative
+    /// to each body's current reference frame; `wx..wz` are body-axis components.
     pub fn states(&self) -> Vec<f64> {
-        vec![]
+        let mut v = self.q().to_vec();
+        v.extend_from_slice(self.u());
+        v
+    }
+
+    /// Set the value of input `i` (held constant until changed).
+    pub fn set_input(&mut self, i: usize, v: f64) {
+        self.dae.inputs[i] = v;
+        self.acc = None;
+        self.radau.reset();
+    }
+}
+
+fn ctx_pose(ctx: &LocalCtx<f64>, m: usize) -> V3<f64> {
+    use crate::model::expr::ExprEnv;
+    ctx.pose(m).p
+}
+
+fn pick(f: LoadFn, fo: [f64; 3], to: [f64; 3]) -> f64 {
+    match f {
+        LoadFn::Fx => fo[0],
+        LoadFn::Fy => fo[1],
+        LoadFn::Fz => fo[2],
+        LoadFn::Tx => to[0],
+        LoadFn::Ty => to[1],
+        LoadFn::Tz => to[2],
     }
 }

@@ -29,11 +29,7 @@ impl<T: Real> M3<T> {
     /// Transpose.
     pub fn t(&self) -> Self {
         let a = &self.0;
-        M3([
-            [a[0][0], a[1][0], a[2][0]],
-            [a[0][1], a[1][1], a[2][1]],
-            [a[0][2], a[1][2], a[2][2]],
-        ])
+        M3([[a[0][0], a[1][0], a[2][0]], [a[0][1], a[1][1], a[2][1]], [a[0][2], a[1][2], a[2][2]]])
     }
     /// Matrix-vector product.
     pub fn mv(&self, v: &V3<T>) -> V3<T> {

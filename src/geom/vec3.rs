@@ -31,11 +31,7 @@ impl<T: Real> V3<T> {
     /// Cross product.
     pub fn cross(&self, o: &Self) -> Self {
         let (a, b) = (&self.0, &o.0);
-        V3([
-            a[1] * b[2] - a[2] * b[1],
-            a[2] * b[0] - a[0] * b[2],
-            a[0] * b[1] - a[1] * b[0],
-        ])
+        V3([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
     }
     /// Euclidean norm.
     pub fn norm(&self) -> T {

@@ -27,11 +27,7 @@ pub struct NumVec {
 impl NumVec {
     /// The values as a 3-vector (panics if the length is not 3; the parser guarantees it).
     pub fn v3(&self) -> [f64; 3] {
-        [
-            self.items[0].value,
-            self.items[1].value,
-            self.items[2].value,
-        ]
+        [self.items[0].value, self.items[1].value, self.items[2].value]
     }
     /// All values.
     pub fn values(&self) -> Vec<f64> {

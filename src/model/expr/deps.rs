@@ -33,14 +33,7 @@ pub struct Deps {
 pub fn deps(e: &Expr) -> Deps {
     let mut d = Deps::default();
     collect(e, &mut d);
-    for v in [
-        &mut d.markers,
-        &mut d.params,
-        &mut d.inputs,
-        &mut d.variables,
-        &mut d.diffs,
-        &mut d.diff_dots,
-    ] {
+    for v in [&mut d.markers, &mut d.params, &mut d.inputs, &mut d.variables, &mut d.diffs, &mut d.diff_dots] {
         v.sort_unstable();
         v.dedup();
     }
@@ -125,16 +118,10 @@ impl ExprEnv<f64> for ConstEnv<'_> {
         f64::NAN
     }
     fn pose(&self, _: MarkerId) -> Pose<f64> {
-        Pose {
-            p: V3::cst([f64::NAN; 3]),
-            r: M3::cst(&[[f64::NAN; 3]; 3]),
-        }
+        Pose { p: V3::cst([f64::NAN; 3]), r: M3::cst(&[[f64::NAN; 3]; 3]) }
     }
     fn twist(&self, _: MarkerId) -> Twist<f64> {
-        Twist {
-            v: V3::cst([f64::NAN; 3]),
-            w: V3::cst([f64::NAN; 3]),
-        }
+        Twist { v: V3::cst([f64::NAN; 3]), w: V3::cst([f64::NAN; 3]) }
     }
     fn accel(&self, m: MarkerId) -> Twist<f64> {
         self.twist(m)
@@ -156,10 +143,7 @@ mod tests {
             BinOp::Add,
             b(Expr::Math(
                 MathFn::Max,
-                vec![
-                    Expr::Kin(KinFn::Vx, 4, Some(1), Some(4)),
-                    Expr::Kin(KinFn::Dx, 2, None, None),
-                ],
+                vec![Expr::Kin(KinFn::Vx, 4, Some(1), Some(4)), Expr::Kin(KinFn::Dx, 2, None, None)],
             )),
             b(Expr::Bin(
                 BinOp::Mul,
@@ -199,11 +183,8 @@ mod tests {
         assert_eq!(d.loads, vec![ElementRef::Joint(5), ElementRef::Sforce(0)]);
         assert!(!is_constant(&e));
 
-        let acc = Expr::Bin(
-            BinOp::Add,
-            b(Expr::Kin(KinFn::Accz, 0, None, None)),
-            b(Expr::Kin(KinFn::Dm, 0, None, None)),
-        );
+        let acc =
+            Expr::Bin(BinOp::Add, b(Expr::Kin(KinFn::Accz, 0, None, None)), b(Expr::Kin(KinFn::Dm, 0, None, None)));
         assert_eq!(deps(&acc).level, 2);
         assert_eq!(deps(&Expr::Num(1.0)), Deps::default());
     }
@@ -214,11 +195,7 @@ mod tests {
         // 2 * p1 ^ 2 - sqrt(p0), p = [4, 3]: 18 - 2 = 16
         let e = Expr::Bin(
             BinOp::Sub,
-            b(Expr::Bin(
-                BinOp::Mul,
-                b(Expr::Num(2.0)),
-                b(Expr::Bin(BinOp::Pow, b(Expr::Param(1)), b(Expr::Num(2.0)))),
-            )),
+            b(Expr::Bin(BinOp::Mul, b(Expr::Num(2.0)), b(Expr::Bin(BinOp::Pow, b(Expr::Param(1)), b(Expr::Num(2.0)))))),
             b(Expr::Math(MathFn::Sqrt, vec![Expr::Param(0)])),
         );
         assert!(is_constant(&e));

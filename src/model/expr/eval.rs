@@ -123,17 +123,11 @@ fn math<T: Real, E: ExprEnv<T> + ?Sized>(f: MathFn, args: &[Expr], env: &E, slot
 }
 
 fn ground_pose<T: Real>() -> Pose<T> {
-    Pose {
-        p: V3::zero(),
-        r: M3::identity(),
-    }
+    Pose { p: V3::zero(), r: M3::identity() }
 }
 
 fn at_rest<T: Real>() -> Twist<T> {
-    Twist {
-        v: V3::zero(),
-        w: V3::zero(),
-    }
+    Twist { v: V3::zero(), w: V3::zero() }
 }
 
 fn pose_of<T: Real, E: ExprEnv<T> + ?Sized>(m: Option<MarkerId>, env: &E) -> Pose<T> {
@@ -158,13 +152,7 @@ fn in_frame<T: Real, E: ExprEnv<T> + ?Sized>(u: V3<T>, k: Option<MarkerId>, env:
 
 /// A kinematic measure of marker `i` relative to `j`, components in `k`. Only the
 /// environment data the measure's level needs is requested.
-fn kin<T: Real, E: ExprEnv<T> + ?Sized>(
-    f: KinFn,
-    i: MarkerId,
-    j: Option<MarkerId>,
-    k: Option<MarkerId>,
-    env: &E,
-) -> T {
+fn kin<T: Real, E: ExprEnv<T> + ?Sized>(f: KinFn, i: MarkerId, j: Option<MarkerId>, k: Option<MarkerId>, env: &E) -> T {
     use KinFn::*;
     let comp = |c: usize, u: V3<T>| in_frame(u, k, env).at(c);
     match f {

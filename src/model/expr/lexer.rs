@@ -45,9 +45,7 @@ pub(super) fn lex(src: &str) -> Vec<Token> {
                 let d = chars[i];
                 let sign_after_exp = (d == '+' || d == '-')
                     && matches!(chars[i - 1], 'e' | 'E')
-                    && chars[start..i - 1]
-                        .iter()
-                        .all(|x| x.is_ascii_digit() || *x == '.');
+                    && chars[start..i - 1].iter().all(|x| x.is_ascii_digit() || *x == '.');
                 if d.is_ascii_alphanumeric() || d == '_' || d == '.' || sign_after_exp {
                     i += 1;
                 } else {
@@ -57,16 +55,11 @@ pub(super) fn lex(src: &str) -> Vec<Token> {
             let text: String = chars[start..i].iter().collect();
             match parse_number(&text) {
                 Some(v) => Tok::Num(v),
-                None => Tok::Bad(ExprError {
-                    offset: start,
-                    msg: format!("bad number '{text}'"),
-                }),
+                None => Tok::Bad(ExprError { offset: start, msg: format!("bad number '{text}'") }),
             }
         } else if c.is_ascii_alphabetic() || c == '_' {
             i += 1;
-            while i < chars.len()
-                && (chars[i].is_ascii_alphanumeric() || chars[i] == '_' || chars[i] == '.')
-            {
+            while i < chars.len() && (chars[i].is_ascii_alphanumeric() || chars[i] == '_' || chars[i] == '.') {
                 i += 1;
             }
             Tok::Ident(chars[start..i].iter().collect())
@@ -75,17 +68,11 @@ pub(super) fn lex(src: &str) -> Vec<Token> {
             Tok::Sym(c)
         } else {
             i += 1;
-            Tok::Bad(ExprError {
-                offset: start,
-                msg: format!("unexpected character '{c}'"),
-            })
+            Tok::Bad(ExprError { offset: start, msg: format!("unexpected character '{c}'") })
         };
         out.push(Token { tok, offset: start });
     }
-    out.push(Token {
-        tok: Tok::End,
-        offset: chars.len(),
-    });
+    out.push(Token { tok: Tok::End, offset: chars.len() });
     out
 }
 
@@ -125,10 +112,7 @@ fn parse_number(text: &str) -> Option<f64> {
             return None;
         }
         // Clamp huge exponents: the value is inf or 0 anyway.
-        let e: i64 = text[i..i + n]
-            .parse::<i64>()
-            .unwrap_or(100_000)
-            .min(100_000);
+        let e: i64 = text[i..i + n].parse::<i64>().unwrap_or(100_000).min(100_000);
         exp = if neg { -e } else { e };
         i += n;
     }
@@ -137,16 +121,8 @@ fn parse_number(text: &str) -> Option<f64> {
     }
     // Rebuild a form Rust's parser always accepts ("1." -> "1.0", ".5" -> "0.5").
     let mant = &text[..mantissa_end];
-    let int_part = if int_digits == 0 {
-        "0"
-    } else {
-        &mant[..int_digits]
-    };
-    let frac_part = if frac_digits == 0 {
-        "0"
-    } else {
-        &mant[int_digits + 1..]
-    };
+    let int_part = if int_digits == 0 { "0" } else { &mant[..int_digits] };
+    let frac_part = if frac_digits == 0 { "0" } else { &mant[int_digits + 1..] };
     format!("{int_part}.{frac_part}e{exp}").parse::<f64>().ok()
 }
 
@@ -160,14 +136,7 @@ mod tests {
 
     #[test]
     fn numbers_in_all_accepted_forms() {
-        for (s, v) in [
-            ("1", 1.0),
-            ("1e-3", 1e-3),
-            (".5", 0.5),
-            ("2.", 2.0),
-            ("1.5E+2", 150.0),
-            ("0.25e1", 2.5),
-        ] {
+        for (s, v) in [("1", 1.0), ("1e-3", 1e-3), (".5", 0.5), ("2.", 2.0), ("1.5E+2", 150.0), ("0.25e1", 2.5)] {
             assert_eq!(parse_number(s), Some(v), "{s}");
         }
         for s in ["1e", "1e+", ".", "1.2.3", "2x", "1e3.5", ".e1"] {
@@ -179,34 +148,10 @@ mod tests {
     #[test]
     fn offsets_count_characters_not_bytes() {
         let t = lex("é + x");
-        assert_eq!(
-            t[0].tok,
-            Tok::Bad(ExprError {
-                offset: 0,
-                msg: "unexpected character 'é'".into()
-            })
-        );
-        assert_eq!(
-            t[1],
-            Token {
-                tok: Tok::Sym('+'),
-                offset: 2
-            }
-        );
-        assert_eq!(
-            t[2],
-            Token {
-                tok: Tok::Ident("x".into()),
-                offset: 4
-            }
-        );
-        assert_eq!(
-            t[3],
-            Token {
-                tok: Tok::End,
-                offset: 5
-            }
-        );
+        assert_eq!(t[0].tok, Tok::Bad(ExprError { offset: 0, msg: "unexpected character 'é'".into() }));
+        assert_eq!(t[1], Token { tok: Tok::Sym('+'), offset: 2 });
+        assert_eq!(t[2], Token { tok: Tok::Ident("x".into()), offset: 4 });
+        assert_eq!(t[3], Token { tok: Tok::End, offset: 5 });
     }
 
     #[test]

@@ -25,11 +25,10 @@ pub fn function_names() -> &'static [&'static str] {
 
 const FUNCTION_NAMES: &[&str] = &[
     // math
-    "sin", "cos", "tan", "asin", "acos", "atan", "atan2", "sinh", "cosh", "tanh", "exp", "log",
-    "sqrt", "abs", "sign", "min", "max", "step", "if", // kinematics
-    "dx", "dy", "dz", "dm", "vx", "vy", "vz", "vm", "vr", "wx", "wy", "wz", "wm", "accx", "accy",
-    "accz", "wdtx", "wdty", "wdtz", "ax", "ay", "az", "psi", "theta", "phi", "yaw", "pitch",
-    "roll", // loads
+    "sin", "cos", "tan", "asin", "acos", "atan", "atan2", "sinh", "cosh", "tanh", "exp", "log", "sqrt", "abs", "sign",
+    "min", "max", "step", "if", // kinematics
+    "dx", "dy", "dz", "dm", "vx", "vy", "vz", "vm", "vr", "wx", "wy", "wz", "wm", "accx", "accy", "accz", "wdtx",
+    "wdty", "wdtz", "ax", "ay", "az", "psi", "theta", "phi", "yaw", "pitch", "roll", // loads
     "fx", "fy", "fz", "tx", "ty", "tz", // differentials
     "dif", "dif1",
 ];
@@ -224,11 +223,7 @@ impl LoadFn {
 /// Never panics. Errors carry the character offset of the offending token and a message
 /// such as `unknown name 'x'` or `'atan2' takes 2 arguments, got 3`.
 pub fn parse(src: &str, scope: &dyn Scope) -> Result<Expr, ExprError> {
-    let mut p = Parser {
-        toks: lex(src),
-        pos: 0,
-        scope,
-    };
+    let mut p = Parser { toks: lex(src), pos: 0, scope };
     let (e, _) = p.sum(0)?;
     match p.peek() {
         Tok::End => Ok(e),
@@ -246,10 +241,7 @@ struct Parser<'a> {
 }
 
 fn err(offset: usize, msg: impl Into<String>) -> ExprError {
-    ExprError {
-        offset,
-        msg: msg.into(),
-    }
+    ExprError { offset, msg: msg.into() }
 }
 
 impl Parser<'_> {
@@ -301,11 +293,7 @@ impl Parser<'_> {
 
     /// Check the depth of a node about to be built from children of depth `d`.
     fn deeper(&self, d: usize, offset: usize) -> Result<usize, ExprError> {
-        if d + 1 > MAX_DEPTH {
-            Err(err(offset, "expression too deeply nested"))
-        } else {
-            Ok(d + 1)
-        }
+        if d + 1 > MAX_DEPTH { Err(err(offset, "expression too deeply nested")) } else { Ok(d + 1) }
     }
 
     fn sum(&mut self, depth: usize) -> Result<Node, ExprError> {
@@ -413,9 +401,7 @@ impl Parser<'_> {
             Some(NameRef::Input(i)) => Ok(Expr::Input(i)),
             Some(NameRef::Variable(i)) => Ok(Expr::Variable(i)),
             Some(NameRef::Diff(i)) => Ok(Expr::Diff(i)),
-            None if FUNCTION_NAMES.contains(&name) => {
-                Err(err(off, format!("function '{name}' needs arguments")))
-            }
+            None if FUNCTION_NAMES.contains(&name) => Err(err(off, format!("function '{name}' needs arguments"))),
             None => Err(err(off, format!("unknown name '{name}'"))),
         }
     }
@@ -441,10 +427,7 @@ impl Parser<'_> {
             let n = f.arity();
             if args.len() != n {
                 let s = if n == 1 { "" } else { "s" };
-                return Err(err(
-                    off,
-                    format!("'{name}' takes {n} argument{s}, got {}", args.len()),
-                ));
+                return Err(err(off, format!("'{name}' takes {n} argument{s}, got {}", args.len())));
             }
             let d = self.deeper(d, off)?;
             return Ok((Expr::Math(f, args), d));
@@ -475,11 +458,7 @@ impl Parser<'_> {
             count(lo, hi)?;
             let mut m: [Option<MarkerId>; 3] = [None; 3];
             for (slot, (a, aoff)) in m.iter_mut().zip(&args) {
-                *slot = Some(
-                    self.scope
-                        .marker(a)
-                        .ok_or_else(|| err(*aoff, format!("unknown marker '{a}'")))?,
-                );
+                *slot = Some(self.scope.marker(a).ok_or_else(|| err(*aoff, format!("unknown marker '{a}'")))?);
             }
             let i = m[0].ok_or_else(|| err(off, "missing marker"))?;
             return Ok((Expr::Kin(f, i, m[1], m[2]), 1));
@@ -487,21 +466,11 @@ impl Parser<'_> {
         count(1, 1)?;
         let (a, aoff) = &args[0];
         if let Some(f) = load {
-            let e: ElementRef = self
-                .scope
-                .element(a)
-                .ok_or_else(|| err(*aoff, format!("unknown element '{a}'")))?;
+            let e: ElementRef = self.scope.element(a).ok_or_else(|| err(*aoff, format!("unknown element '{a}'")))?;
             return Ok((Expr::Load(f, e), 1));
         }
         match self.scope.name(a) {
-            Some(NameRef::Diff(i)) => Ok((
-                if name == "dif" {
-                    Expr::Diff(i)
-                } else {
-                    Expr::DiffDot(i)
-                },
-                1,
-            )),
+            Some(NameRef::Diff(i)) => Ok((if name == "dif" { Expr::Diff(i) } else { Expr::DiffDot(i) }, 1)),
             Some(_) => Err(err(*aoff, format!("'{a}' is not a differential"))),
             None => Err(err(*aoff, format!("unknown name '{a}'"))),
         }

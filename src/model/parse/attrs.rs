@@ -74,8 +74,7 @@ impl<'a> El<'a> {
     }
     /// Attribute `name`, required.
     pub fn req(&self, name: &str) -> Result<&'a XAttr, ModelError> {
-        self.get(name)
-            .ok_or_else(|| self.err(format!("missing required attribute '{name}'")))
+        self.get(name).ok_or_else(|| self.err(format!("missing required attribute '{name}'")))
     }
 
     /// Position of character `char_off` of attribute `a`'s value.
@@ -84,20 +83,14 @@ impl<'a> El<'a> {
             return a.pos;
         };
         let rest = self.src.text.get(start..).unwrap_or("");
-        let byte = rest
-            .char_indices()
-            .nth(char_off)
-            .map_or(rest.len(), |(b, _)| b);
+        let byte = rest.char_indices().nth(char_off).map_or(rest.len(), |(b, _)| b);
         self.src.pos(start + byte)
     }
 
     /// Parse `text` (item at char offset `off` of attribute `a`) as an expression.
     pub fn parse_expr(&self, a: &XAttr, off: usize, text: &str) -> Result<Expr, ModelError> {
         expr::parse(text, self.scope).map_err(|e| {
-            self.err_at(
-                self.value_pos(a, off + e.offset),
-                format!("bad expression in '{}': {}", a.name, e.msg),
-            )
+            self.err_at(self.value_pos(a, off + e.offset), format!("bad expression in '{}': {}", a.name, e.msg))
         })
     }
 
@@ -107,10 +100,7 @@ impl<'a> El<'a> {
         if !expr::is_constant(&e) {
             return Err(self.err_at(
                 self.value_pos(a, off),
-                format!(
-                    "'{}' must be a constant expression (numbers, pi, parameters)",
-                    a.name
-                ),
+                format!("'{}' must be a constant expression (numbers, pi, parameters)", a.name),
             ));
         }
         Ok(e)
@@ -121,10 +111,7 @@ impl<'a> El<'a> {
         let e = self.const_expr(a, off, text)?;
         let value = expr::const_value(&e, self.params);
         if !value.is_finite() {
-            return Err(self.err_at(
-                self.value_pos(a, off),
-                format!("'{}' evaluates to {value}", a.name),
-            ));
+            return Err(self.err_at(self.value_pos(a, off), format!("'{}' evaluates to {value}", a.name)));
         }
         Ok(Num { expr: e, value })
     }
@@ -135,8 +122,7 @@ impl<'a> El<'a> {
             return Ok(None);
         };
         let off = a.value.len() - a.value.trim_start().len();
-        self.num_item(a, a.value[..off].chars().count(), a.value.trim())
-            .map(Some)
+        self.num_item(a, a.value[..off].chars().count(), a.value.trim()).map(Some)
     }
     /// Constant attribute with a default value.
     pub fn num_or(&self, name: &str, default: f64) -> Result<Num, ModelError> {
@@ -145,27 +131,15 @@ impl<'a> El<'a> {
     /// Required constant attribute.
     pub fn num_req(&self, name: &str) -> Result<Num, ModelError> {
         self.req(name)?;
-        self.num(name)?
-            .ok_or_else(|| self.err(format!("missing required attribute '{name}'")))
+        self.num(name)?.ok_or_else(|| self.err(format!("missing required attribute '{name}'")))
     }
 
     /// Split attribute `a` into items, checking the count is one of `counts`.
     fn items(&self, a: &'a XAttr, counts: &[usize]) -> Result<Vec<(usize, &'a str)>, ModelError> {
         let items = split_items(&a.value);
         if !counts.contains(&items.len()) {
-            let want = counts
-                .iter()
-                .map(|c| c.to_string())
-                .collect::<Vec<_>>()
-                .join(" or ");
-            return Err(self.err_at(
-                a.pos,
-                format!(
-                    "attribute '{}' needs {want} items, found {}",
-                    a.name,
-                    items.len()
-                ),
-            ));
+            let want = counts.iter().map(|c| c.to_string()).collect::<Vec<_>>().join(" or ");
+            return Err(self.err_at(a.pos, format!("attribute '{}' needs {want} items, found {}", a.name, items.len())));
         }
         Ok(items)
     }
@@ -185,8 +159,7 @@ impl<'a> El<'a> {
     /// Required constant 3-vector.
     pub fn vec3_req(&self, name: &str) -> Result<NumVec, ModelError> {
         self.req(name)?;
-        self.num_vec(name, &[3])?
-            .ok_or_else(|| self.err(format!("missing required attribute '{name}'")))
+        self.num_vec(name, &[3])?.ok_or_else(|| self.err(format!("missing required attribute '{name}'")))
     }
 
     /// Required expression attribute.
@@ -206,16 +179,11 @@ impl<'a> El<'a> {
         for (off, t) in items {
             out.push(self.parse_expr(a, off, t)?);
         }
-        out.try_into()
-            .map_err(|_| self.err_at(a.pos, format!("attribute '{name}' needs 3 items")))
+        out.try_into().map_err(|_| self.err_at(a.pos, format!("attribute '{name}' needs 3 items")))
     }
 
     /// Optional keyword attribute among `choices`.
-    pub fn keyword<T: Copy>(
-        &self,
-        name: &str,
-        choices: &[(&str, T)],
-    ) -> Result<Option<T>, ModelError> {
+    pub fn keyword<T: Copy>(&self, name: &str, choices: &[(&str, T)]) -> Result<Option<T>, ModelError> {
         let Some(a) = self.get(name) else {
             return Ok(None);
         };
@@ -223,30 +191,19 @@ impl<'a> El<'a> {
         match choices.iter().find(|(k, _)| *k == v) {
             Some(&(_, t)) => Ok(Some(t)),
             None => {
-                let list = choices
-                    .iter()
-                    .map(|(k, _)| *k)
-                    .collect::<Vec<_>>()
-                    .join(", ");
-                Err(self.err_at(
-                    a.pos,
-                    format!("bad value '{v}' for '{name}' (expected {list})"),
-                ))
+                let list = choices.iter().map(|(k, _)| *k).collect::<Vec<_>>().join(", ");
+                Err(self.err_at(a.pos, format!("bad value '{v}' for '{name}' (expected {list})")))
             }
         }
     }
     /// Required keyword attribute.
     pub fn keyword_req<T: Copy>(&self, name: &str, choices: &[(&str, T)]) -> Result<T, ModelError> {
         self.req(name)?;
-        self.keyword(name, choices)?
-            .ok_or_else(|| self.err(format!("missing required attribute '{name}'")))
+        self.keyword(name, choices)?.ok_or_else(|| self.err(format!("missing required attribute '{name}'")))
     }
 }
 
 /// A literal constant.
 pub(crate) fn constant(v: f64) -> Num {
-    Num {
-        expr: Expr::Num(v),
-        value: v,
-    }
+    Num { expr: Expr::Num(v), value: v }
 }

@@ -9,10 +9,8 @@ use super::xml::XElem;
 use crate::model::expr::{MarkerId, Scope};
 use crate::model::*;
 
-const SPRING_TYPES: &[(&str, SpringType)] = &[
-    ("translational", SpringType::Translational),
-    ("rotational", SpringType::Rotational),
-];
+const SPRING_TYPES: &[(&str, SpringType)] =
+    &[("translational", SpringType::Translational), ("rotational", SpringType::Rotational)];
 
 impl<'a> Loader<'a> {
     /// Build all elements (motions last: they refer to joints of any position).
@@ -41,11 +39,7 @@ impl<'a> Loader<'a> {
                 "constraint" => {
                     let function = el.expr_req("function")?;
                     check_deps(&el, "function", &function, Allowed::Positions)?;
-                    let c = UserConstraint {
-                        name: x.label().into(),
-                        function,
-                        pos: x.pos,
-                    };
+                    let c = UserConstraint { name: x.label().into(), function, pos: x.pos };
                     self.model.constraints.push(c);
                 }
                 "spring_damper" => {
@@ -128,14 +122,10 @@ impl<'a> Loader<'a> {
     fn body(&mut self, x: &'a XElem) -> Result<(), ModelError> {
         let el = self.el(x);
         let mass = el.num_req("mass")?;
-        check_mass(mass.value)
-            .map_err(|m| el.err_at(el.get("mass").map_or(x.pos, |a| a.pos), m))?;
+        check_mass(mass.value).map_err(|m| el.err_at(el.get("mass").map_or(x.pos, |a| a.pos), m))?;
         el.req("inertia")?;
-        let inertia = el
-            .num_vec("inertia", &[3, 6])?
-            .unwrap_or(NumVec { items: vec![] });
-        check_inertia(&inertia.values())
-            .map_err(|m| el.err_at(el.get("inertia").map_or(x.pos, |a| a.pos), m))?;
+        let inertia = el.num_vec("inertia", &[3, 6])?.unwrap_or(NumVec { items: vec![] });
+        check_inertia(&inertia.values()).map_err(|m| el.err_at(el.get("inertia").map_or(x.pos, |a| a.pos), m))?;
         let body = Body {
             name: x.label().into(),
             mass,
@@ -152,9 +142,7 @@ impl<'a> Loader<'a> {
         self.model.markers.push(Marker {
             name: format!("{name}.cm"),
             body: Some(idx),
-            position: NumVec {
-                items: vec![constant(0.0), constant(0.0), constant(0.0)],
-            },
+            position: NumVec { items: vec![constant(0.0), constant(0.0), constant(0.0)] },
             orientation: Orientation::Identity,
             pos: x.pos,
         });
@@ -194,27 +182,15 @@ impl<'a> Loader<'a> {
         let el = self.el(x);
         let a = el.req("joint")?;
         let name = a.value.trim();
-        let joint = self
-            .ns_joints
-            .get(name)
-            .ok_or_else(|| el.err_at(el.value_pos(a, 0), format!("unknown joint '{name}'")))?;
-        let dof = el.keyword_req(
-            "dof",
-            &[
-                ("rotation", MotionDof::Rotation),
-                ("translation", MotionDof::Translation),
-            ],
-        )?;
+        let joint =
+            self.ns_joints.get(name).ok_or_else(|| el.err_at(el.value_pos(a, 0), format!("unknown joint '{name}'")))?;
+        let dof =
+            el.keyword_req("dof", &[("rotation", MotionDof::Rotation), ("translation", MotionDof::Translation)])?;
         let kind = self.model.joints.get(joint).map(|j| j.kind);
         let ok = matches!(
             (dof, kind),
-            (
-                MotionDof::Rotation,
-                Some(JointType::Revolute | JointType::Cylindrical)
-            ) | (
-                MotionDof::Translation,
-                Some(JointType::Translational | JointType::Cylindrical)
-            )
+            (MotionDof::Rotation, Some(JointType::Revolute | JointType::Cylindrical))
+                | (MotionDof::Translation, Some(JointType::Translational | JointType::Cylindrical))
         );
         if !ok {
             let (need, dof_name) = match dof {
@@ -223,20 +199,11 @@ impl<'a> Loader<'a> {
             };
             let has = kind.map_or("unknown", joint_type_name);
             let at = el.get("dof").map_or(x.pos, |a| a.pos);
-            return Err(el.err_at(
-                at,
-                format!("dof '{dof_name}' needs a {need} joint; joint '{name}' is {has}"),
-            ));
+            return Err(el.err_at(at, format!("dof '{dof_name}' needs a {need} joint; joint '{name}' is {has}")));
         }
         let function = el.expr_req("function")?;
         check_deps(&el, "function", &function, Allowed::Time)?;
-        Ok(Motion {
-            name: x.label().into(),
-            joint,
-            dof,
-            function,
-            pos: x.pos,
-        })
+        Ok(Motion { name: x.label().into(), joint, dof, function, pos: x.pos })
     }
 
     fn linearization(&mut self, x: &'a XElem) -> Result<(), ModelError> {
@@ -246,18 +213,10 @@ impl<'a> Loader<'a> {
             let (name, pos) = (c.label().to_string(), c.pos);
             if c.tag == "state" {
                 check_deps(&el, "function", &function, Allowed::Positions)?;
-                self.model.lin_states.push(LinState {
-                    name,
-                    function,
-                    pos,
-                });
+                self.model.lin_states.push(LinState { name, function, pos });
             } else {
                 check_deps(&el, "function", &function, Allowed::Velocities)?;
-                self.model.lin_velocities.push(LinVelocity {
-                    name,
-                    function,
-                    pos,
-                });
+                self.model.lin_velocities.push(LinVelocity { name, function, pos });
             }
         }
         Ok(())
@@ -275,10 +234,7 @@ const JOINT_TYPES: &[(&str, JointType)] = &[
 ];
 
 fn joint_type_name(t: JointType) -> &'static str {
-    JOINT_TYPES
-        .iter()
-        .find(|(_, k)| *k == t)
-        .map_or("?", |(n, _)| n)
+    JOINT_TYPES.iter().find(|(_, k)| *k == t).map_or("?", |(n, _)| n)
 }
 
 fn joint(el: &El) -> Result<Joint, ModelError> {
@@ -292,10 +248,7 @@ fn joint(el: &El) -> Result<Joint, ModelError> {
         ("ic_speed", tra, "translational and cylindrical"),
     ] {
         if let (Some(a), false) = (el.get(attr), ok) {
-            let msg = format!(
-                "attribute '{attr}' is not allowed on a {} joint (only {types})",
-                joint_type_name(kind)
-            );
+            let msg = format!("attribute '{attr}' is not allowed on a {} joint (only {types})", joint_type_name(kind));
             return Err(el.err_at(a.pos, msg));
         }
     }
@@ -319,13 +272,8 @@ fn spring_damper(el: &El) -> Result<SpringDamper, ModelError> {
         SpringType::Rotational => ("angle", "length"),
     };
     if let Some(a) = el.get(other) {
-        let t = if kind == SpringType::Translational {
-            "translational"
-        } else {
-            "rotational"
-        };
-        let msg =
-            format!("attribute '{other}' is not allowed on a {t} spring_damper (use '{len_attr}')");
+        let t = if kind == SpringType::Translational { "translational" } else { "rotational" };
+        let msg = format!("attribute '{other}' is not allowed on a {t} spring_damper (use '{len_attr}')");
         return Err(el.err_at(a.pos, msg));
     }
     let length = match kind {
@@ -358,15 +306,9 @@ fn opt_marker_ref(el: &El, attr: &str) -> Result<Option<MarkerId>, ModelError> {
     };
     let name = a.value.trim();
     let lead = a.value.len() - a.value.trim_start().len();
-    let hint = if name == "ground" {
-        " (ground has no cm marker: name one, ground.<marker>)"
-    } else {
-        ""
-    };
-    el.scope.marker(name).map(Some).ok_or_else(|| {
-        el.err_at(
-            el.value_pos(a, lead),
-            format!("unknown marker '{name}'{hint}"),
-        )
-    })
+    let hint = if name == "ground" { " (ground has no cm marker: name one, ground.<marker>)" } else { "" };
+    el.scope
+        .marker(name)
+        .map(Some)
+        .ok_or_else(|| el.err_at(el.value_pos(a, lead), format!("unknown marker '{name}'{hint}")))
 }

@@ -9,83 +9,33 @@ use crate::model::ModelError;
 use crate::model::expr::{ElementRef, NameRef};
 
 /// Elements of the format that this version does not read yet.
-const UNSUPPORTED: &[&str] = &[
-    "differential",
-    "variable",
-    "bushing",
-    "rolling_wheel",
-    "knife_edge",
-    "velocity_constraint",
-];
+const UNSUPPORTED: &[&str] =
+    &["differential", "variable", "bushing", "rolling_wheel", "knife_edge", "velocity_constraint"];
 
 /// Allowed and required attributes of each supported element.
 pub(crate) fn schema(tag: &str) -> Option<(&'static [&'static str], &'static [&'static str])> {
     Some(match tag {
         "multibody" => (&["name", "version"], &["name", "version"]),
-        "parameter" => (
-            &["name", "value", "description", "unit"],
-            &["name", "value"],
-        ),
+        "parameter" => (&["name", "value", "description", "unit"], &["name", "value"]),
         "gravity" => (&["value"], &["value"]),
         "ground" | "linearization" => (&[], &[]),
         "body" => (
-            &[
-                "name",
-                "mass",
-                "inertia",
-                "position",
-                "euler313",
-                "z_axis",
-                "x_axis",
-                "velocity",
-                "angular_velocity",
-            ],
+            &["name", "mass", "inertia", "position", "euler313", "z_axis", "x_axis", "velocity", "angular_velocity"],
             &["name", "mass", "inertia", "position"],
         ),
-        "marker" => (
-            &["name", "position", "euler313", "z_axis", "x_axis"],
-            &["name", "position"],
-        ),
+        "marker" => (&["name", "position", "euler313", "z_axis", "x_axis"], &["name", "position"]),
         "joint" => (
-            &[
-                "name",
-                "type",
-                "i",
-                "j",
-                "ic_angle",
-                "ic_angular_speed",
-                "ic_displacement",
-                "ic_speed",
-            ],
+            &["name", "type", "i", "j", "ic_angle", "ic_angular_speed", "ic_displacement", "ic_speed"],
             &["name", "type", "i", "j"],
         ),
-        "motion" => (
-            &["name", "joint", "dof", "function"],
-            &["name", "joint", "dof", "function"],
-        ),
+        "motion" => (&["name", "joint", "dof", "function"], &["name", "joint", "dof", "function"]),
         "constraint" | "state" | "velocity" => (&["name", "function"], &["name", "function"]),
         "spring_damper" => (
-            &[
-                "name",
-                "type",
-                "i",
-                "j",
-                "stiffness",
-                "damping",
-                "length",
-                "angle",
-                "preload",
-            ],
+            &["name", "type", "i", "j", "stiffness", "damping", "length", "angle", "preload"],
             &["name", "type", "i", "j", "stiffness"],
         ),
-        "sforce" => (
-            &["name", "type", "i", "j", "function"],
-            &["name", "type", "i", "j", "function"],
-        ),
-        "gforce" => (
-            &["name", "i", "j", "frame", "force", "torque"],
-            &["name", "i"],
-        ),
+        "sforce" => (&["name", "type", "i", "j", "function"], &["name", "type", "i", "j", "function"]),
+        "gforce" => (&["name", "i", "j", "frame", "force", "torque"], &["name", "i"]),
         "input" => (&["name", "start", "unit"], &["name"]),
         "output" => (&["name", "function", "unit"], &["name", "function"]),
         "experiment" => (&["start", "stop", "step", "tolerance"], &[]),
@@ -135,10 +85,7 @@ impl<'a> Loader<'a> {
             return Err(el.err("unknown element"));
         };
         if !allowed_here.contains(&x.tag.as_str()) {
-            return Err(el.err(format!(
-                "element <{}> is not allowed inside <{parent}>",
-                x.tag
-            )));
+            return Err(el.err(format!("element <{}> is not allowed inside <{parent}>", x.tag)));
         }
         el.check_attrs(allowed, required)?;
         for c in &x.children {
@@ -167,24 +114,13 @@ impl<'a> Loader<'a> {
         };
         ns.declare(&full, idx, x.pos.line).map_err(|line| {
             let what = if is_marker { "marker" } else { kind };
-            el.err_at(
-                a.pos,
-                format!(
-                    "duplicate {what} name '{}' (first defined at line {line})",
-                    a.value
-                ),
-            )
+            el.err_at(a.pos, format!("duplicate {what} name '{}' (first defined at line {line})", a.value))
         })?;
         Ok(full)
     }
 
     /// Declare a bare name usable in expressions (parameters and inputs share these).
-    fn declare_bare(
-        &mut self,
-        x: &'a XElem,
-        kind: &'static str,
-        r: NameRef,
-    ) -> Result<(), ModelError> {
+    fn declare_bare(&mut self, x: &'a XElem, kind: &'static str, r: NameRef) -> Result<(), ModelError> {
         let mut tmp = Namespace::default();
         let name = self.declare(&mut tmp, x, kind, 0, false)?;
         if let Some(&(prev, line)) = self.scope.names.get(&name) {
@@ -231,12 +167,7 @@ impl<'a> Loader<'a> {
         Ok(())
     }
 
-    fn declare_markers(
-        &mut self,
-        x: &'a XElem,
-        owner: &str,
-        body: Option<usize>,
-    ) -> Result<(), ModelError> {
+    fn declare_markers(&mut self, x: &'a XElem, owner: &str, body: Option<usize>) -> Result<(), ModelError> {
         for m in &x.children {
             let idx = self.scope.marker_body.len();
             let mut ns = std::mem::take(&mut self.ns_markers);
@@ -252,10 +183,7 @@ impl<'a> Loader<'a> {
     /// Reject a second occurrence of a once-only element.
     fn once(&mut self, x: &'a XElem) -> Result<(), ModelError> {
         if let Some(line) = self.singletons.get(&x.tag) {
-            let msg = format!(
-                "only one <{}> element is allowed (first at line {line})",
-                x.tag
-            );
+            let msg = format!("only one <{}> element is allowed (first at line {line})", x.tag);
             return Err(self.el(x).err(msg));
         }
         self.singletons.insert(x.tag.clone(), x.pos.line);
@@ -359,12 +287,7 @@ impl<'a> Loader<'a> {
 
     /// An attribute reader for `x` with the current scope and parameter values.
     pub(crate) fn el(&self, x: &'a XElem) -> El<'_> {
-        El {
-            x,
-            src: self.src,
-            scope: &self.scope,
-            params: &self.params,
-        }
+        El { x, src: self.src, scope: &self.scope, params: &self.params }
     }
 }
 

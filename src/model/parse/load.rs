@@ -83,10 +83,7 @@ impl<'a> Loader<'a> {
         let root = self.root;
         let el = self.el(root);
         if root.tag != "multibody" {
-            return Err(el.err(format!(
-                "root element must be <multibody>, found <{}>",
-                root.tag
-            )));
+            return Err(el.err(format!("root element must be <multibody>, found <{}>", root.tag)));
         }
         el.check_attrs(&["name", "version"], &["name", "version"])?;
         let name = el.req("name")?;
@@ -95,10 +92,7 @@ impl<'a> Loader<'a> {
         }
         let version = el.req("version")?;
         if version.value.trim() != "1" {
-            let msg = format!(
-                "unsupported version '{}' (this reader knows version \"1\")",
-                version.value
-            );
+            let msg = format!("unsupported version '{}' (this reader knows version \"1\")", version.value);
             return Err(el.err_at(version.pos, msg));
         }
         self.model.name = name.value.clone();
@@ -107,12 +101,7 @@ impl<'a> Loader<'a> {
 
     /// Parameters: parse every value, then evaluate in dependency order.
     fn evaluate_parameters(&mut self) -> Result<(), ModelError> {
-        let xs: Vec<&XElem> = self
-            .root
-            .children
-            .iter()
-            .filter(|x| x.tag == "parameter")
-            .collect();
+        let xs: Vec<&XElem> = self.root.children.iter().filter(|x| x.tag == "parameter").collect();
         let mut exprs = Vec::with_capacity(xs.len());
         let mut names = Vec::with_capacity(xs.len());
         for x in &xs {

@@ -1,11 +1,11 @@
 //! The model-file reader: XML text → validated [`Model`](crate::model::Model), every
 //! error located as `file:line:col: element 'name': message`.
 //!
-//! One concept per file: [`source`] (positions), [`xml`] (element tree), [`attrs`]
-//! (attributes, vectors, constants), [`orient`] (orientations), [`names`] (names and
-//! the expression scope), [`params`] (parameter evaluation order), [`declare`] and
-//! [`build`] (the two passes over elements), [`validate`] (value and level checks),
-//! [`model_impl`] (queries on a loaded model).
+//! One concept per file: `source` (positions), `xml` (element tree), `attrs`
+//! (attributes, vectors, constants), `orient` (orientations), `names` (names and
+//! the expression scope), `params` (parameter evaluation order), `declare` and
+//! `build` (the two passes over elements), `validate` (value and level checks),
+//! `model_impl` (queries on a loaded model).
 
 mod attrs;
 mod build;

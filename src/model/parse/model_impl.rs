@@ -57,15 +57,10 @@ impl Model {
     /// Index in [`Model::markers`] of a marker by full name (`body.marker`, `ground.marker`,
     /// `body.cm`); a bare body name means its `cm` marker.
     pub fn marker_index(&self, full_name: &str) -> Option<usize> {
-        self.markers
-            .iter()
-            .position(|m| m.name == full_name)
-            .or_else(|| {
-                let b = self.bodies.iter().position(|b| b.name == full_name)?;
-                self.markers
-                    .iter()
-                    .position(|m| m.body == Some(b) && m.name == format!("{full_name}.cm"))
-            })
+        self.markers.iter().position(|m| m.name == full_name).or_else(|| {
+            let b = self.bodies.iter().position(|b| b.name == full_name)?;
+            self.markers.iter().position(|m| m.body == Some(b) && m.name == format!("{full_name}.cm"))
+        })
     }
 
     /// Every constant attribute (not the parameters' own values), for re-evaluation.
@@ -79,10 +74,7 @@ impl Model {
             v.extend(vec_nums(&mut b.inertia));
             v.extend(vec_nums(&mut b.position));
             v.extend(orientation_nums(&mut b.orientation));
-            for w in [&mut b.velocity, &mut b.angular_velocity]
-                .into_iter()
-                .flatten()
-            {
+            for w in [&mut b.velocity, &mut b.angular_velocity].into_iter().flatten() {
                 v.extend(vec_nums(w));
             }
         }
@@ -91,21 +83,11 @@ impl Model {
             v.extend(orientation_nums(&mut m.orientation));
         }
         for j in &mut self.joints {
-            let ics = [
-                &mut j.ic_angle,
-                &mut j.ic_angular_speed,
-                &mut j.ic_displacement,
-                &mut j.ic_speed,
-            ];
+            let ics = [&mut j.ic_angle, &mut j.ic_angular_speed, &mut j.ic_displacement, &mut j.ic_speed];
             v.extend(ics.into_iter().flatten());
         }
         for s in &mut self.spring_dampers {
-            v.extend([
-                &mut s.stiffness,
-                &mut s.damping,
-                &mut s.length,
-                &mut s.preload,
-            ]);
+            v.extend([&mut s.stiffness, &mut s.damping, &mut s.length, &mut s.preload]);
         }
         for i in &mut self.inputs {
             v.push(&mut i.start);
@@ -119,11 +101,7 @@ impl Model {
     /// degenerate axes).
     pub fn with_params(&self, values: &[f64]) -> Result<Model, String> {
         if values.len() != self.parameters.len() {
-            return Err(format!(
-                "expected {} parameter values, got {}",
-                self.parameters.len(),
-                values.len()
-            ));
+            return Err(format!("expected {} parameter values, got {}", self.parameters.len(), values.len()));
         }
         let mut m = self.clone();
         for (p, &v) in m.parameters.iter_mut().zip(values) {
@@ -135,10 +113,7 @@ impl Model {
         for n in m.nums_mut() {
             n.value = const_value(&n.expr, values);
             if !n.value.is_finite() {
-                return Err(format!(
-                    "an attribute evaluates to {} with these parameters",
-                    n.value
-                ));
+                return Err(format!("an attribute evaluates to {} with these parameters", n.value));
             }
         }
         if let Some(g) = &m.gravity_expr {
@@ -159,19 +134,9 @@ impl Model {
     pub fn summary(&self) -> Summary {
         let bodies = self.bodies.len();
         let coordinates = 6 * bodies;
-        let constraints = self
-            .joints
-            .iter()
-            .map(|j| j.kind.equations())
-            .sum::<usize>()
-            + self.motions.len()
-            + self.constraints.len();
+        let constraints =
+            self.joints.iter().map(|j| j.kind.equations()).sum::<usize>() + self.motions.len() + self.constraints.len();
         let dof = coordinates as isize - constraints as isize;
-        Summary {
-            bodies,
-            coordinates,
-            constraints,
-            dof,
-        }
+        Summary { bodies, coordinates, constraints, dof }
     }
 }

@@ -6,13 +6,9 @@ use std::collections::HashMap;
 /// Why `name` is not a valid element name, if it is not.
 pub(crate) fn invalid_name(name: &str, is_marker: bool) -> Option<String> {
     let mut chars = name.chars();
-    let ok_start = chars
-        .next()
-        .is_some_and(|c| c.is_ascii_alphabetic() || c == '_');
+    let ok_start = chars.next().is_some_and(|c| c.is_ascii_alphabetic() || c == '_');
     if !ok_start || !chars.all(|c| c.is_ascii_alphanumeric() || c == '_') {
-        return Some(format!(
-            "invalid name '{name}' (names are [A-Za-z_][A-Za-z0-9_]*)"
-        ));
+        return Some(format!("invalid name '{name}' (names are [A-Za-z_][A-Za-z0-9_]*)"));
     }
     if matches!(name, "pi" | "time" | "ground") {
         return Some(format!("invalid name '{name}' (reserved word)"));
@@ -69,10 +65,7 @@ impl Scope for ModelScope {
         self.names.get(name).map(|&(r, _)| r)
     }
     fn marker(&self, name: &str) -> Option<MarkerId> {
-        self.markers
-            .get(name)
-            .or_else(|| self.body_cm.get(name))
-            .copied()
+        self.markers.get(name).or_else(|| self.body_cm.get(name)).copied()
     }
     fn element(&self, name: &str) -> Option<ElementRef> {
         self.elements.get(name).map(|&(r, _, _)| r)

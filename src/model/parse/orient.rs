@@ -10,10 +10,7 @@ pub(crate) fn read_orientation(el: &El) -> Result<Orientation, ModelError> {
     let x = el.num_vec("x_axis", &[3])?;
     let o = match (euler, z, x) {
         (Some(_), Some(_), _) | (Some(_), None, Some(_)) => {
-            let at = el
-                .get("z_axis")
-                .or(el.get("x_axis"))
-                .map_or(el.x.pos, |a| a.pos);
+            let at = el.get("z_axis").or(el.get("x_axis")).map_or(el.x.pos, |a| a.pos);
             return Err(el.err_at(at, "give either euler313 or z_axis [x_axis], not both"));
         }
         (None, None, Some(_)) => {
@@ -25,11 +22,7 @@ pub(crate) fn read_orientation(el: &El) -> Result<Orientation, ModelError> {
         (None, None, None) => Orientation::Identity,
     };
     if let Err(msg) = try_rotation(&o) {
-        let name = if msg.starts_with("x_axis") {
-            "x_axis"
-        } else {
-            "z_axis"
-        };
+        let name = if msg.starts_with("x_axis") { "x_axis" } else { "z_axis" };
         let at = el.get(name).map_or(el.x.pos, |a| a.pos);
         return Err(el.err_at(at, msg));
     }
@@ -77,11 +70,7 @@ pub fn try_rotation(o: &Orientation) -> Result<[[f64; 3]; 3], String> {
                     scale(xp, 1.0 / n)
                 }
                 None => {
-                    let e = if z[0].abs() > 0.9 {
-                        [0.0, 1.0, 0.0]
-                    } else {
-                        [1.0, 0.0, 0.0]
-                    };
+                    let e = if z[0].abs() > 0.9 { [0.0, 1.0, 0.0] } else { [1.0, 0.0, 0.0] };
                     let xp = sub(e, scale(z, dot(e, z)));
                     scale(xp, 1.0 / norm(xp))
                 }
@@ -108,9 +97,5 @@ fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 }

@@ -7,17 +7,8 @@ use crate::model::expr::{self, Expr};
 /// the parameter where it was found and the cycle's names (`a -> b -> a`).
 pub(crate) fn evaluate(exprs: &[Expr], names: &[String]) -> Result<Vec<f64>, (usize, String)> {
     let n = exprs.len();
-    let deps: Vec<Vec<usize>> = exprs
-        .iter()
-        .map(|e| {
-            expr::deps(e)
-                .params
-                .iter()
-                .copied()
-                .filter(|&p| p < n)
-                .collect()
-        })
-        .collect();
+    let deps: Vec<Vec<usize>> =
+        exprs.iter().map(|e| expr::deps(e).params.iter().copied().filter(|&p| p < n).collect()).collect();
     let mut state = vec![0u8; n]; // 0 new, 1 on stack, 2 done
     let mut order = Vec::with_capacity(n);
     for start in 0..n {
@@ -38,10 +29,7 @@ pub(crate) fn evaluate(exprs: &[Expr], names: &[String]) -> Result<Vec<f64>, (us
                     }
                     1 => {
                         let from = stack.iter().position(|&(s, _)| s == d).unwrap_or(0);
-                        let mut cyc: Vec<&str> = stack[from..]
-                            .iter()
-                            .map(|&(s, _)| names[s].as_str())
-                            .collect();
+                        let mut cyc: Vec<&str> = stack[from..].iter().map(|&(s, _)| names[s].as_str()).collect();
                         cyc.push(&names[d]);
                         return Err((d, format!("dependency cycle {}", cyc.join(" -> "))));
                     }

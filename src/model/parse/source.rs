@@ -13,11 +13,7 @@ impl<'t> Source<'t> {
     pub fn new(text: &'t str, file: &str) -> Self {
         let mut line_starts = vec![0];
         line_starts.extend(text.match_indices('\n').map(|(i, _)| i + 1));
-        Source {
-            file: file.to_string(),
-            text,
-            line_starts,
-        }
+        Source { file: file.to_string(), text, line_starts }
     }
 
     /// Line and column (in characters, both 1-based) of byte offset `off`.
@@ -25,11 +21,7 @@ impl<'t> Source<'t> {
         let off = off.min(self.text.len());
         let line = self.line_starts.partition_point(|&s| s <= off).max(1);
         let start = self.line_starts[line - 1];
-        let col = self
-            .text
-            .get(start..off)
-            .map_or(off - start, |s| s.chars().count())
-            + 1;
+        let col = self.text.get(start..off).map_or(off - start, |s| s.chars().count()) + 1;
         SrcPos { line, col }
     }
 
@@ -41,13 +33,7 @@ impl<'t> Source<'t> {
     }
 
     /// A located error.
-    pub fn error(
-        &self,
-        pos: SrcPos,
-        element: &str,
-        name: &str,
-        msg: impl Into<String>,
-    ) -> ModelError {
+    pub fn error(&self, pos: SrcPos, element: &str, name: &str, msg: impl Into<String>) -> ModelError {
         ModelError {
             file: self.file.clone(),
             pos,

@@ -6,22 +6,14 @@ use crate::model::expr::{self, Expr};
 
 /// A mass must be positive.
 pub(crate) fn check_mass(m: f64) -> Result<(), String> {
-    if m > 0.0 {
-        Ok(())
-    } else {
-        Err(format!("mass must be positive (got {m})"))
-    }
+    if m > 0.0 { Ok(()) } else { Err(format!("mass must be positive (got {m})")) }
 }
 
 /// The inertia matrix `[[Ixx,Ixy,Ixz],[Ixy,Iyy,Iyz],[Ixz,Iyz,Izz]]` must be positive
 /// definite (checked by Cholesky factorization); `v` holds 3 or 6 entries.
 pub(crate) fn check_inertia(v: &[f64]) -> Result<(), String> {
     let g = |k: usize| v.get(k).copied().unwrap_or(0.0);
-    let (xy, xz, yz) = if v.len() == 6 {
-        (g(3), g(4), g(5))
-    } else {
-        (0.0, 0.0, 0.0)
-    };
+    let (xy, xz, yz) = if v.len() == 6 { (g(3), g(4), g(5)) } else { (0.0, 0.0, 0.0) };
     let a = [[g(0), xy, xz], [xy, g(1), yz], [xz, yz, g(2)]];
     let mut l = [[0.0f64; 3]; 3];
     for i in 0..3 {
@@ -56,20 +48,12 @@ pub(crate) enum Allowed {
 }
 
 /// Check that expression `e` of attribute `attr` uses only what `allowed` permits.
-pub(crate) fn check_deps(
-    el: &El,
-    attr: &str,
-    e: &Expr,
-    allowed: Allowed,
-) -> Result<(), ModelError> {
+pub(crate) fn check_deps(el: &El, attr: &str, e: &Expr, allowed: Allowed) -> Result<(), ModelError> {
     let d = expr::deps(e);
     let at = el.get(attr).map_or(el.x.pos, |a| a.pos);
     if allowed == Allowed::Force {
         if d.level >= 2 || !d.loads.is_empty() {
-            return Err(el.err_at(
-                at,
-                "forces depending on accelerations or loads are not supported yet",
-            ));
+            return Err(el.err_at(at, "forces depending on accelerations or loads are not supported yet"));
         }
         return Ok(());
     }
@@ -80,11 +64,7 @@ pub(crate) fn check_deps(
     let used = if allowed == Allowed::Time && !d.markers.is_empty() {
         Some("marker measures")
     } else if d.level > max_level {
-        Some(if d.level >= 2 {
-            "accelerations"
-        } else {
-            "velocities"
-        })
+        Some(if d.level >= 2 { "accelerations" } else { "velocities" })
     } else if !d.inputs.is_empty() {
         Some("inputs")
     } else if !d.loads.is_empty() {

@@ -51,24 +51,14 @@ pub(crate) fn read(src: &Source) -> Result<XElem, ModelError> {
             Ok(ev) => ev,
             Err(e) => {
                 let at = usize::try_from(reader.error_position()).unwrap_or(0);
-                return Err(src.error(
-                    src.pos(at),
-                    "xml",
-                    "document",
-                    format!("malformed XML: {e}"),
-                ));
+                return Err(src.error(src.pos(at), "xml", "document", format!("malformed XML: {e}")));
             }
         };
         match ev {
             Event::Start(e) => {
                 let el = element(src, &e, before)?;
                 if stack.len() >= MAX_DEPTH {
-                    return Err(src.error(
-                        el.pos,
-                        &el.tag,
-                        el.label(),
-                        "elements nested too deeply",
-                    ));
+                    return Err(src.error(el.pos, &el.tag, el.label(), "elements nested too deeply"));
                 }
                 stack.push(el);
             }
@@ -96,20 +86,11 @@ pub(crate) fn read(src: &Source) -> Result<XElem, ModelError> {
     if let Some(open) = stack.last() {
         return Err(src.error(open.pos, &open.tag, open.label(), "element is not closed"));
     }
-    root.ok_or_else(|| {
-        src.error(
-            SrcPos { line: 1, col: 1 },
-            "multibody",
-            "multibody",
-            "no <multibody> root element",
-        )
-    })
+    root.ok_or_else(|| src.error(SrcPos { line: 1, col: 1 }, "multibody", "multibody", "no <multibody> root element"))
 }
 
 fn unexpected_text(src: &Source, stack: &[XElem], off: usize) -> ModelError {
-    let (tag, name) = stack
-        .last()
-        .map_or(("multibody", "multibody"), |e| (&e.tag, e.label()));
+    let (tag, name) = stack.last().map_or(("multibody", "multibody"), |e| (&e.tag, e.label()));
     let mut at = off;
     // Point at the first non-blank character of the text.
     if let Some(rest) = src.text.get(off..) {
@@ -118,12 +99,7 @@ fn unexpected_text(src: &Source, stack: &[XElem], off: usize) -> ModelError {
     src.error(src.pos(at), tag, name, "unexpected text")
 }
 
-fn attach(
-    src: &Source,
-    stack: &mut [XElem],
-    root: &mut Option<XElem>,
-    el: XElem,
-) -> Result<(), ModelError> {
+fn attach(src: &Source, stack: &mut [XElem], root: &mut Option<XElem>, el: XElem) -> Result<(), ModelError> {
     if let Some(parent) = stack.last_mut() {
         parent.children.push(el);
     } else if root.is_some() {
@@ -137,31 +113,18 @@ fn attach(
 fn element(src: &Source, e: &BytesStart, before: usize) -> Result<XElem, ModelError> {
     let tag = e.name().0.to_string();
     // The name borrows from the text; the `<` is just before it.
-    let lt = src
-        .offset_of(e.name().0)
-        .map_or(before, |o| o.saturating_sub(1));
+    let lt = src.offset_of(e.name().0).map_or(before, |o| o.saturating_sub(1));
     let pos = src.pos(lt);
     let mut attrs = Vec::new();
     for a in e.attributes() {
-        let a =
-            a.map_err(|err| src.error(pos, &tag, &tag, format!("bad attribute syntax: {err}")))?;
+        let a = a.map_err(|err| src.error(pos, &tag, &tag, format!("bad attribute syntax: {err}")))?;
         let name = a.key.0.to_string();
         let apos = src.offset_of(a.key.0).map_or(pos, |o| src.pos(o));
         let value = a
             .normalized_value(quick_xml::XmlVersion::Implicit1_0)
             .map_err(|err| src.error(apos, &tag, &tag, format!("bad attribute '{name}': {err}")))?
             .into_owned();
-        attrs.push(XAttr {
-            name,
-            value,
-            pos: apos,
-            value_off: src.offset_of(&a.value),
-        });
+        attrs.push(XAttr { name, value, pos: apos, value_off: src.offset_of(&a.value) });
     }
-    Ok(XElem {
-        tag,
-        pos,
-        attrs,
-        children: Vec::new(),
-    })
+    Ok(XElem { tag, pos, attrs, children: Vec::new() })
 }

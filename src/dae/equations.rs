@@ -1,0 +1,264 @@
+//! The equations of motion as the integrator sees them: y = [q; u; λ; μ] and
+//!   q̇ = H(q)u − C_qᵀμ            (Eq. 13b, with the GGL stabilizing term; μ = 0 exactly)
+//!   M u̇ = Q(u, q, t) − Pᵀλ       (Eq. 13a, P = C_q H)
+//!   0 = C(q, t)                   (Eq. 13e)
+//!   0 = C_q H u + C_t             (Eq. 13d)
+//! with exact sparse Jacobians from the element kernels.
+
+use super::sparse::Triplets;
+use crate::mechanics::System;
+use crate::mechanics::body::{NQ, h_transpose_times, qdot};
+use crate::mechanics::kernels::{
+    constraint_first, constraint_second, dhtw_dq, dqdot_dq, force_jacobian, force_values, gather, gyroscopic,
+};
+
+/// Index layout of y.
+#[derive(Clone, Copy, Debug)]
+pub struct Layout {
+    pub n: usize,
+    pub m: usize,
+}
+
+impl Layout {
+    /// Total dimension 2n + 2m.
+    pub fn dim(&self) -> usize {
+        2 * self.n + 2 * self.m
+    }
+    /// Offset of u.
+    pub fn u(&self) -> usize {
+        self.n
+    }
+    /// Offset of λ.
+    pub fn lam(&self) -> usize {
+        2 * self.n
+    }
+    /// Offset of μ.
+    pub fn mu(&self) -> usize {
+        2 * self.n + self.m
+    }
+}
+
+/// Global index of local coordinate `a` of an element touching `bodies`.
+#[inline]
+fn glob(bodies: &[usize], a: usize) -> usize {
+    NQ * bodies[a / NQ] + a % NQ
+}
+
+/// Applied generalized forces Q(u, q, t): gravity, gyroscopic terms and force elements.
+pub fn applied_forces(sys: &System, q: &[f64], u: &[f64], t: f64, inputs: &[f64], out: &mut [f64]) {
+    for (b, body) in sys.bodies.iter().enumerate() {
+        let o = NQ * b;
+        for c in 0..3 {
+            out[o + c] = body.mass * sys.gravity[c];
+        }
+        let (g, _) = gyroscopic(&body.inertia, &u[o + 3..o + 6]);
+        out[o + 3..o + 6].copy_from_slice(&g);
+    }
+    for el in &sys.forces {
+        let v = force_values(sys, el, q, u, t, inputs);
+        for (a, x) in v.iter().enumerate() {
+            out[glob(&el.bodies, a)] += x;
+        }
+    }
+}
+
+/// P row of one equation (local, 6 per body) from its C_q row: P = C_q H.
+pub fn p_row(bodies: &[usize], q: &[f64], cq: &[f64]) -> Vec<f64> {
+    let mut p = vec![0.0; cq.len()];
+    for (k, &b) in bodies.iter().enumerate() {
+        let r = h_transpose_times(&q[NQ * b..NQ * b + NQ], &cq[NQ * k..NQ * k + NQ]);
+        p[NQ * k..NQ * k + NQ].copy_from_slice(&r);
+    }
+    p
+}
+
+/// f(t, y) of the stabilized index-2 system.
+pub fn rhs(sys: &System, lay: Layout, t: f64, y: &[f64], inputs: &[f64], f: &mut [f64]) {
+    let (n, nu, nl, nm) = (lay.n, lay.u(), lay.lam(), lay.mu());
+    let (q, u) = (&y[..n], &y[nu..nu + n]);
+    for b in 0..sys.nb() {
+        let o = NQ * b;
+        f[o..o + NQ].copy_from_slice(&qdot(&q[o..o + NQ], &u[o..o + NQ]));
+    }
+    applied_forces(sys, q, u, t, inputs, &mut f[nu..nu + n]);
+    for el in &sys.constraints {
+        let cf = constraint_first(sys, el, q, t, inputs);
+        let nql = NQ * el.bodies.len();
+        let ul = gather(&el.bodies, u);
+        for e in 0..el.neq {
+            let row = el.row + e;
+            let cq = &cf.cq[e * nql..(e + 1) * nql];
+            let p = p_row(&el.bodies, q, cq);
+            let (lam, mu) = (y[nl + row], y[nm + row]);
+            f[nl + row] = cf.c[e];
+            f[nm + row] = p.iter().zip(&ul).map(|(a, b)| a * b).sum::<f64>() + cf.ct[e];
+            for a in 0..nql {
+                let g = glob(&el.bodies, a);
+                f[nu + g] -= p[a] * lam;
+                f[g] -= cq[a] * mu;
+            }
+        }
+    }
+}
+
+/// J = ∂f/∂y, exact except for the term ∂(C_qᵀμ)/∂q, which vanishes on the solution (μ = 0).
+pub fn jacobian(sys: &System, lay: Layout, t: f64, y: &[f64], inputs: &[f64], jac: &mut Triplets) {
+    let (n, nu, nl, nm) = (lay.n, lay.u(), lay.lam(), lay.mu());
+    let (q, u) = (&y[..n], &y[nu..nu + n]);
+    for (b, body) in sys.bodies.iter().enumerate() {
+        let o = NQ * b;
+        let (qb, ub) = (&q[o..o + NQ], &u[o..o + NQ]);
+        let dq = dqdot_dq(qb, ub);
+        for r in 3..6 {
+            for c in 3..6 {
+                jac.push(o + r, o + c, dq[r * 6 + c]);
+            }
+        }
+        // ∂q̇/∂u = H: identity for v, the Euler block for ω'.
+        for c in 0..3 {
+            jac.push(o + c, nu + o + c, 1.0);
+        }
+        let h = crate::mechanics::body::h_angular(qb[4], qb[5]);
+        for r in 0..3 {
+            for c in 0..3 {
+                jac.push(o + 3 + r, nu + o + 3 + c, h.0[r][c]);
+            }
+        }
+        let (_, gj) = gyroscopic(&body.inertia, &ub[3..6]);
+        for r in 0..3 {
+            for c in 0..3 {
+                jac.push(nu + o + 3 + r, nu + o + 3 + c, gj[r * 3 + c]);
+            }
+        }
+    }
+    for el in &sys.forces {
+        let nql = NQ * el.bodies.len();
+        let (_, fj) = force_jacobian(sys, el, q, u, t, inputs);
+        for r in 0..nql {
+            let gr = nu + glob(&el.bodies, r);
+            for a in 0..nql {
+                let ga = glob(&el.bodies, a);
+                jac.push(gr, ga, fj[r * 2 * nql + a]);
+                jac.push(gr, nu + ga, fj[r * 2 * nql + nql + a]);
+            }
+        }
+    }
+    for el in &sys.constraints {
+        let s = constraint_second(sys, el, q, t, inputs);
+        let nql = NQ * el.bodies.len();
+        let k = s.k;
+        let ql = gather(&el.bodies, q);
+        let ul = gather(&el.bodies, u);
+        let mut qd = vec![0.0; nql];
+        let mut dq = Vec::with_capacity(el.bodies.len());
+        for kb in 0..el.bodies.len() {
+            let r = NQ * kb..NQ * kb + NQ;
+            qd[r.clone()].copy_from_slice(&qdot(&ql[r.clone()], &ul[r.clone()]));
+            dq.push(dqdot_dq(&ql[r.clone()], &ul[r]));
+        }
+        let mut lq = vec![0.0; nql * nql];
+        for e in 0..el.neq {
+            let row = el.row + e;
+            let lam = y[nl + row];
+            let g = &s.grad[e * k..(e + 1) * k];
+            let hs = &s.hess[e * k * k..(e + 1) * k * k];
+            let p = p_row(&el.bodies, q, &g[..nql]);
+            for a in 0..nql {
+                let ga = glob(&el.bodies, a);
+                // C_q (Eq. 13e rows), −C_qᵀ (q̇ rows, μ column), −Pᵀ (u rows, λ column), P (Ċ rows).
+                jac.push(nl + row, ga, g[a]);
+                jac.push(ga, nm + row, -g[a]);
+                jac.push(nu + ga, nl + row, -p[a]);
+                jac.push(nm + row, nu + ga, p[a]);
+                // Ċ_q = Σ_c C_qc,qa q̇_c + C_q ∂q̇/∂q_a + C_t,qa.
+                let kb = a / NQ;
+                let mut v = hs[a * k + nql];
+                for c in 0..nql {
+                    v += hs[c * k + a] * qd[c];
+                }
+                for c in 0..NQ {
+                    v += g[NQ * kb + c] * dq[kb][c * 6 + a % NQ];
+                }
+                jac.push(nm + row, ga, v);
+            }
+            if lam != 0.0 {
+                // (Pᵀλ)_q = λ [Hᵀ ∂C_q/∂q + ∂(Hᵀ w)/∂q |_{w = C_q}].
+                for a in 0..nql {
+                    let col: Vec<f64> = (0..nql).map(|c| hs[c * k + a]).collect();
+                    let ht = p_row(&el.bodies, q, &col);
+                    for r in 0..nql {
+                        lq[r * nql + a] += lam * ht[r];
+                    }
+                }
+                for (kb, &b) in el.bodies.iter().enumerate() {
+                    let d = dhtw_dq(&q[NQ * b..NQ * b + NQ], &g[NQ * kb..NQ * kb + NQ]);
+                    for r in 0..NQ {
+                        for c in 0..NQ {
+                            lq[(NQ * kb + r) * nql + NQ * kb + c] += lam * d[r * 6 + c];
+                        }
+                    }
+                }
+            }
+        }
+        for r in 0..nql {
+            for a in 0..nql {
+                jac.push(nu + glob(&el.bodies, r), glob(&el.bodies, a), -lq[r * nql + a]);
+            }
+        }
+    }
+}
+
+/// The constant mass matrix diag(I, M, 0, 0) of the integrator's M y' = f.
+pub fn mass_matrix(sys: &System, lay: Layout, m: &mut Triplets) {
+    for i in 0..lay.n {
+        m.push(i, i, 1.0);
+    }
+    for (b, body) in sys.bodies.iter().enumerate() {
+        let o = lay.u() + NQ * b;
+        for c in 0..3 {
+            m.push(o + c, o + c, body.mass);
+        }
+        for r in 0..3 {
+            for c in 0..3 {
+                m.push(o + 3 + r, o + 3 + c, body.inertia[r][c]);
+            }
+        }
+    }
+}
+
+/// γ of the acceleration constraint P u̇ + γ = 0 (Eq. 1c): the part of C̈ free of u̇.
+pub fn acceleration_rhs(sys: &System, q: &[f64], u: &[f64], t: f64, inputs: &[f64]) -> Vec<f64> {
+    let mut gamma = vec![0.0; sys.m];
+    for el in &sys.constraints {
+        let s = constraint_second(sys, el, q, t, inputs);
+        let nql = NQ * el.bodies.len();
+        let k = s.k;
+        let ql = gather(&el.bodies, q);
+        let ul = gather(&el.bodies, u);
+        // z' = (q̇, 1): γ = z'ᵀ ∇²C z' + C_q (∂q̇/∂q) q̇.
+        let mut zd = vec![1.0; k];
+        let mut extra = vec![0.0; nql];
+        for kb in 0..el.bodies.len() {
+            let r = NQ * kb..NQ * kb + NQ;
+            let qd = qdot(&ql[r.clone()], &ul[r.clone()]);
+            zd[r.clone()].copy_from_slice(&qd);
+            let dq = dqdot_dq(&ql[r.clone()], &ul[r]);
+            for i in 0..NQ {
+                extra[NQ * kb + i] = (0..NQ).map(|c| dq[i * 6 + c] * qd[c]).sum();
+            }
+        }
+        for e in 0..el.neq {
+            let g = &s.grad[e * k..(e + 1) * k];
+            let hs = &s.hess[e * k * k..(e + 1) * k * k];
+            let mut v = 0.0;
+            for a in 0..k {
+                for c in 0..k {
+                    v += zd[a] * hs[a * k + c] * zd[c];
+                }
+            }
+            v += (0..nql).map(|a| g[a] * extra[a]).sum::<f64>();
+            gamma[el.row + e] = v;
+        }
+    }
+    gamma
+}

@@ -1,0 +1,203 @@
+//! Initialization (MODEL_FORMAT "Initial conditions"): assemble positions with the
+//! smallest change (Gauss–Newton, minimum-norm corrections: [I C_qᵀ; C_q 0]), then
+//! consistent velocities (closest to the given ones), then accelerations and Lagrange
+//! multipliers from [M Pᵀ; P 0][u̇; λ] = [Q; −γ] (Eq. 1c–1d).
+
+use super::equations::{acceleration_rhs, applied_forces, p_row};
+use super::sparse::{SparseLu, Triplets};
+use crate::mechanics::System;
+use crate::mechanics::body::NQ;
+use crate::mechanics::constraints::ConstraintEl;
+use crate::mechanics::kernels::{constraint_first, gather};
+use crate::mechanics::local::LocalCtx;
+
+/// Constraint values and Jacobian (triplets, rows offset by `row0`) of a set of elements.
+fn eval_set(
+    sys: &System,
+    els: &[ConstraintEl],
+    q: &[f64],
+    t: f64,
+    inputs: &[f64],
+    row0: usize,
+    c: &mut [f64],
+    cq: &mut Triplets,
+    col0: usize,
+    transpose_too: bool,
+) {
+    for el in els {
+        let f = constraint_first(sys, el, q, t, inputs);
+        let nql = NQ * el.bodies.len();
+        for e in 0..el.neq {
+            let r = row0 + el.row + e;
+            c[el.row + e] = f.c[e];
+            for a in 0..nql {
+                let g = NQ * el.bodies[a / NQ] + a % NQ;
+                cq.push(r, col0 + g, f.cq[e * nql + a]);
+                if transpose_too {
+                    cq.push(col0 + g, r, f.cq[e * nql + a]);
+                }
+            }
+        }
+    }
+}
+
+/// Name of the element holding constraint row `row`.
+fn row_owner(els: &[ConstraintEl], row: usize) -> String {
+    els.iter().find(|e| row >= e.row && row < e.row + e.neq).map_or("?".into(), |e| {
+        if e.neq > 1 { format!("'{}' (equation {})", e.name, row - e.row + 1) } else { format!("'{}'", e.name) }
+    })
+}
+
+/// Assemble positions: q closest to `q` (step by step) with C(q, t) = 0 and exact ICs.
+pub fn assemble_positions(sys: &System, q: &mut [f64], t: f64, inputs: &[f64], tol: f64) -> Result<(), String> {
+    let n = sys.n();
+    let els: Vec<ConstraintEl> = sys.constraints.iter().chain(sys.ic_constraints.iter()).cloned().collect();
+    let mr: usize = els.iter().map(|e| e.neq).sum();
+    if mr == 0 {
+        return Ok(());
+    }
+    let mut lu = SparseLu::new();
+    let mut c = vec![0.0; mr];
+    let scale = 1.0 + q.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    let mut last = f64::INFINITY;
+    for _ in 0..100 {
+        let mut kkt = Triplets::new();
+        for i in 0..n {
+            kkt.push(i, i, 1.0);
+        }
+        eval_set(sys, &els, q, t, inputs, n, &mut c, &mut kkt, 0, true);
+        let worst =
+            c.iter().enumerate().fold((0, 0.0f64), |(k, w), (i, v)| if v.abs() > w { (i, v.abs()) } else { (k, w) });
+        if !worst.1.is_finite() {
+            return Err(format!("cannot assemble: constraint {} is not finite", row_owner(&els, worst.0)));
+        }
+        if worst.1 <= tol * scale {
+            return Ok(());
+        }
+        if let Err(e) = lu.factor(n + mr, &kkt) {
+            return Err(format!(
+                "cannot assemble: constraint Jacobian is singular ({e}); redundant or conflicting constraints near {}",
+                row_owner(&els, worst.0)
+            ));
+        }
+        let mut rhs = vec![0.0; n + mr];
+        for (i, v) in c.iter().enumerate() {
+            rhs[n + i] = -v;
+        }
+        if !lu.solve(&mut rhs) {
+            return Err(format!(
+                "cannot assemble: redundant or conflicting constraints near {}",
+                row_owner(&els, worst.0)
+            ));
+        }
+        for i in 0..n {
+            q[i] += rhs[i];
+        }
+        last = worst.1;
+    }
+    let _ = last;
+    // Report the worst constraint after the iterations.
+    let mut kkt = Triplets::new();
+    eval_set(sys, &els, q, t, inputs, n, &mut c, &mut kkt, 0, false);
+    let worst =
+        c.iter().enumerate().fold((0, 0.0f64), |(k, w), (i, v)| if v.abs() > w { (i, v.abs()) } else { (k, w) });
+    Err(format!("cannot assemble: constraint {} cannot be met (residual {:.3e})", row_owner(&els, worst.0), worst.1))
+}
+
+/// Consistent velocities: u closest to `u` with P u + C_t = 0 and exact velocity ICs.
+pub fn assemble_velocities(sys: &System, q: &[f64], u: &mut [f64], t: f64, inputs: &[f64]) -> Result<(), String> {
+    let n = sys.n();
+    let m = sys.m;
+    let nic = sys.ic_velocities.len();
+    let mut kkt = Triplets::new();
+    for i in 0..n {
+        kkt.push(i, i, 1.0);
+    }
+    let mut rhs = vec![0.0; n + m + nic];
+    rhs[..n].copy_from_slice(u);
+    for el in &sys.constraints {
+        let f = constraint_first(sys, el, q, t, inputs);
+        let nql = NQ * el.bodies.len();
+        for e in 0..el.neq {
+            let r = n + el.row + e;
+            let p = p_row(&el.bodies, q, &f.cq[e * nql..(e + 1) * nql]);
+            for (a, pa) in p.iter().enumerate() {
+                let g = NQ * el.bodies[a / NQ] + a % NQ;
+                kkt.push(r, g, *pa);
+                kkt.push(g, r, *pa);
+            }
+            rhs[r] = -f.ct[e];
+        }
+    }
+    for (k, ic) in sys.ic_velocities.iter().enumerate() {
+        // Linear in u: residual(u) = a·u − value; a from dual numbers seeded on u.
+        use crate::ad::{Dual, Real};
+        let ql: Vec<Dual<f64, 24>> = gather(&ic.bodies, q).iter().map(|&v| Dual::cst(v)).collect();
+        let ul: Vec<Dual<f64, 24>> = gather(&ic.bodies, u).iter().enumerate().map(|(i, &v)| Dual::var(v, i)).collect();
+        let ctx = LocalCtx::new(sys, &ic.bodies, &ql, &ul, &[], Dual::cst(t), inputs);
+        let res = ic.eval(&ctx);
+        let r = n + m + k;
+        let mut au = 0.0;
+        for a in 0..NQ * ic.bodies.len() {
+            let g = NQ * ic.bodies[a / NQ] + a % NQ;
+            kkt.push(r, g, res.d[a]);
+            kkt.push(g, r, res.d[a]);
+            au += res.d[a] * u[g];
+        }
+        rhs[r] = au - res.val();
+    }
+    let mut lu = SparseLu::new();
+    lu.factor(n + m + nic, &kkt).map_err(|e| format!("cannot make velocities consistent: {e}"))?;
+    if !lu.solve(&mut rhs) {
+        return Err("cannot make velocities consistent: singular velocity constraints".into());
+    }
+    u.copy_from_slice(&rhs[..n]);
+    Ok(())
+}
+
+/// Accelerations u̇ and multipliers λ: [M Pᵀ; P 0][u̇; λ] = [Q; −γ].
+pub fn accelerations(
+    sys: &System,
+    q: &[f64],
+    u: &[f64],
+    t: f64,
+    inputs: &[f64],
+    lu: &mut SparseLu,
+) -> Result<(Vec<f64>, Vec<f64>), String> {
+    let n = sys.n();
+    let m = sys.m;
+    let mut kkt = Triplets::new();
+    for (b, body) in sys.bodies.iter().enumerate() {
+        let o = NQ * b;
+        for c in 0..3 {
+            kkt.push(o + c, o + c, body.mass);
+        }
+        for r in 0..3 {
+            for c in 0..3 {
+                kkt.push(o + 3 + r, o + 3 + c, body.inertia[r][c]);
+            }
+        }
+    }
+    let mut rhs = vec![0.0; n + m];
+    applied_forces(sys, q, u, t, inputs, &mut rhs[..n]);
+    let gamma = acceleration_rhs(sys, q, u, t, inputs);
+    for el in &sys.constraints {
+        let f = constraint_first(sys, el, q, t, inputs);
+        let nql = NQ * el.bodies.len();
+        for e in 0..el.neq {
+            let r = n + el.row + e;
+            let p = p_row(&el.bodies, q, &f.cq[e * nql..(e + 1) * nql]);
+            for (a, pa) in p.iter().enumerate() {
+                let g = NQ * el.bodies[a / NQ] + a % NQ;
+                kkt.push(r, g, *pa);
+                kkt.push(g, r, *pa);
+            }
+            rhs[r] = -gamma[el.row + e];
+        }
+    }
+    lu.factor(n + m, &kkt).map_err(|e| format!("cannot solve accelerations: {e}"))?;
+    if !lu.solve(&mut rhs) {
+        return Err("cannot solve accelerations: singular (redundant constraints?)".into());
+    }
+    Ok((rhs[..n].to_vec(), rhs[n..].to_vec()))
+}

@@ -1,0 +1,379 @@
+//! Radau IIA (3 stages, order 5) for M y' = f(t, y) with a constant singular M: the
+//! multibody DAE in stabilized index-2 form (positions and velocity constraints both
+//! enforced at every step end, since the method is stiffly accurate). Simplified Newton
+//! on the transformed stage system: one real (γ/h M − J) and one 2n real block
+//! [[α/h M − J, β/h M], [−β/h M, α/h M − J]] sparse LU; embedded error estimate and
+//! step-size control after Hairer & Wanner's RADAU5 (Solving ODEs II, IV.8).
+
+use super::radau_tableau::Tableau;
+use super::sparse::{SparseLu, Triplets};
+
+/// The DAE the integrator solves.
+pub trait DaeProblem {
+    /// Dimension of y.
+    fn dim(&self) -> usize;
+    /// f(t, y).
+    fn rhs(&mut self, t: f64, y: &[f64], f: &mut [f64]) -> Result<(), String>;
+    /// J = ∂f/∂y (exact or a good approximation); the pattern must not depend on values.
+    fn jacobian(&mut self, t: f64, y: &[f64], j: &mut Triplets) -> Result<(), String>;
+    /// The constant mass matrix M.
+    fn mass(&self, m: &mut Triplets);
+    /// Per component: 0 = differential (error-controlled), 2 = index-2 algebraic.
+    fn index(&self) -> Vec<u8>;
+    /// Called after each accepted step; returns true if it changed coordinates of y
+    /// (e.g. re-based Euler angles), which invalidates extrapolation and the Jacobian.
+    fn accepted(&mut self, t: f64, y: &mut [f64]) -> bool;
+}
+
+/// Integrator statistics.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Stats {
+    pub steps: usize,
+    pub accepted: usize,
+    pub rejected: usize,
+    pub newton_iterations: usize,
+    pub jacobians: usize,
+    pub factorizations: usize,
+    pub rhs_evaluations: usize,
+}
+
+/// Integrator state.
+pub struct Radau {
+    tb: Tableau,
+    /// User tolerance and the internal (RADAU5-calibrated) ones.
+    rtol: f64,
+    atol: f64,
+    pub t: f64,
+    pub y: Vec<f64>,
+    /// Next step size to try.
+    pub h: f64,
+    pub max_step: f64,
+    f0: Vec<f64>,
+    f0_valid: bool,
+    jac: Triplets,
+    jac_fresh: bool,
+    need_jac: bool,
+    mass: Triplets,
+    mass_diag_idx: Vec<u8>,
+    lu1: SparseLu,
+    lu2: SparseLu,
+    h_fact: f64,
+    cont: Option<[Vec<f64>; 3]>,
+    h_old: f64,
+    first: bool,
+    last_rejected: bool,
+    faccon: f64,
+    pub stats: Stats,
+}
+
+const NIT: usize = 7;
+const SAFE: f64 = 0.9;
+const FACL: f64 = 5.0;
+const FACR: f64 = 0.125;
+const THET: f64 = 0.001;
+
+impl Radau {
+    /// New integrator at (t0, y0) with tolerance `tol` (relative and absolute).
+    pub fn new<P: DaeProblem>(p: &P, t0: f64, y0: Vec<f64>, tol: f64) -> Radau {
+        // RADAU5's calibration: its error estimate is of order 3, so the requested
+        // tolerance is mapped to 0.1·tol^(2/3) to make the achieved error ≈ tol.
+        let rtol = 0.1 * tol.powf(2.0 / 3.0);
+        let mut mass = Triplets::new();
+        p.mass(&mut mass);
+        Radau {
+            tb: Tableau::new(),
+            rtol,
+            atol: rtol,
+            t: t0,
+            f0: vec![0.0; y0.len()],
+            y: y0,
+            h: 1e-4,
+            max_step: f64::INFINITY,
+            f0_valid: false,
+            jac: Triplets::new(),
+            jac_fresh: false,
+            need_jac: true,
+            mass,
+            mass_diag_idx: p.index(),
+            lu1: SparseLu::new(),
+            lu2: SparseLu::new(),
+            h_fact: f64::NAN,
+            cont: None,
+            h_old: 0.0,
+            first: true,
+            last_rejected: false,
+            faccon: 1.0,
+            stats: Stats::default(),
+        }
+    }
+
+    /// Forget extrapolation data and the Jacobian (after y was changed from outside).
+    pub fn reset(&mut self) {
+        self.cont = None;
+        self.need_jac = true;
+        self.f0_valid = false;
+        self.first = true;
+    }
+
+    /// Integrate to exactly `t_end`.
+    pub fn advance<P: DaeProblem>(&mut self, p: &mut P, t_end: f64) -> Result<(), String> {
+        let hmin = 1e-14 * t_end.abs().max(1.0);
+        while t_end - self.t > hmin {
+            let natural = self.h.min(self.max_step);
+            let rest = t_end - self.t;
+            let (h, clipped) = if natural >= rest * (1.0 - 1e-12) {
+                (rest, true)
+            } else if natural > 0.5 * rest {
+                (0.5 * rest, false)
+            } else {
+                (natural, false)
+            };
+            let (ok, hnew) = self.step(p, h)?;
+            if ok {
+                // A clipped step keeps the natural size for later steps unless it shrank.
+                self.h = if clipped { hnew.max(natural) } else { hnew };
+            } else {
+                self.h = hnew;
+                if self.h < hmin {
+                    return Err(format!("step size underflow at t = {:.9e}", self.t));
+                }
+            }
+        }
+        self.t = t_end;
+        Ok(())
+    }
+
+    fn scal(&self, y: &[f64], h: f64) -> Vec<f64> {
+        y.iter()
+            .zip(&self.mass_diag_idx)
+            .map(|(v, &ix)| {
+                let s = self.atol + self.rtol * v.abs();
+                if ix == 2 { s / h } else { s }
+            })
+            .collect()
+    }
+
+    fn factor(&mut self, n: usize, h: f64) -> Result<(), String> {
+        let tb = &self.tb;
+        let mut e1 = Triplets::new();
+        for (p, v) in self.jac.idx.iter().zip(&self.jac.vals) {
+            e1.push(p.row, p.col, -v);
+        }
+        for (p, v) in self.mass.idx.iter().zip(&self.mass.vals) {
+            e1.push(p.row, p.col, tb.gamma / h * v);
+        }
+        let mut e2 = Triplets::new();
+        for blk in 0..2 {
+            let o = blk * n;
+            for (p, v) in self.jac.idx.iter().zip(&self.jac.vals) {
+                e2.push(o + p.row, o + p.col, -v);
+            }
+            for (p, v) in self.mass.idx.iter().zip(&self.mass.vals) {
+                e2.push(o + p.row, o + p.col, tb.alpha / h * v);
+            }
+        }
+        for (p, v) in self.mass.idx.iter().zip(&self.mass.vals) {
+            e2.push(p.row, n + p.col, tb.beta / h * v);
+            e2.push(n + p.row, p.col, -tb.beta / h * v);
+        }
+        self.lu1.factor(n, &e1)?;
+        self.lu2.factor(2 * n, &e2)?;
+        self.h_fact = h;
+        self.stats.factorizations += 1;
+        Ok(())
+    }
+
+    fn mass_mul(&self, x: &[f64]) -> Vec<f64> {
+        let mut y = vec![0.0; x.len()];
+        self.mass.mul_add(x, &mut y);
+        y
+    }
+
+    /// One step attempt of size h: (accepted?, proposed next h).
+    fn step<P: DaeProblem>(&mut self, p: &mut P, h: f64) -> Result<(bool, f64), String> {
+        let n = self.y.len();
+        self.stats.steps += 1;
+        if !self.f0_valid {
+            p.rhs(self.t, &self.y, &mut self.f0)?;
+            self.stats.rhs_evaluations += 1;
+            self.f0_valid = true;
+        }
+        if self.need_jac {
+            self.jac.clear();
+            p.jacobian(self.t, &self.y, &mut self.jac)?;
+            self.stats.jacobians += 1;
+            self.jac_fresh = true;
+            self.need_jac = false;
+            self.h_fact = f64::NAN;
+        }
+        if self.h_fact != h && self.factor(n, h).is_err() {
+            self.stats.rejected += 1;
+            self.need_jac = !self.jac_fresh;
+            return Ok((false, 0.5 * h));
+        }
+        let tb = self.tb.clone();
+        let scal = self.scal(&self.y, h);
+        // Starting values: extrapolate the previous collocation polynomial.
+        let mut z: [Vec<f64>; 3] = std::array::from_fn(|_| vec![0.0; n]);
+        if let Some(c) = &self.cont {
+            let c3q = h / self.h_old;
+            for (s, zs) in z.iter_mut().enumerate() {
+                let cq = tb.c[s] * c3q;
+                for i in 0..n {
+                    zs[i] = cq * (c[0][i] + (cq - tb.c[1] + 1.0) * (c[1][i] + (cq - tb.c[0] + 1.0) * c[2][i]));
+                }
+            }
+        }
+        let mut w: [Vec<f64>; 3] =
+            std::array::from_fn(|r| (0..n).map(|i| (0..3).map(|s| tb.ti[r][s] * z[s][i]).sum()).collect());
+        // Simplified Newton iteration.
+        let fnewt = (10.0 * f64::EPSILON / self.rtol).max(0.03f64.min(self.rtol.sqrt()));
+        let mut faccon = self.faccon.max(f64::EPSILON).powf(0.8);
+        let mut dyno_old = 0.0;
+        let mut theta = 1.0;
+        let mut newt = 0;
+        let mut yi = vec![0.0; n];
+        let mut f: [Vec<f64>; 3] = std::array::from_fn(|_| vec![0.0; n]);
+        loop {
+            if newt >= NIT {
+                return self.newton_failed(h);
+            }
+            for s in 0..3 {
+                for i in 0..n {
+                    yi[i] = self.y[i] + z[s][i];
+                }
+                if p.rhs(self.t + tb.c[s] * h, &yi, &mut f[s]).is_err() {
+                    return self.newton_failed(h);
+                }
+                self.stats.rhs_evaluations += 1;
+            }
+            // G = (T⁻¹ ⊗ I) F, then the Newton right-hand sides.
+            let g: [Vec<f64>; 3] =
+                std::array::from_fn(|r| (0..n).map(|i| (0..3).map(|s| tb.ti[r][s] * f[s][i]).sum()).collect());
+            let mw0 = self.mass_mul(&w[0]);
+            let mw1 = self.mass_mul(&w[1]);
+            let mw2 = self.mass_mul(&w[2]);
+            let mut r1: Vec<f64> = (0..n).map(|i| g[0][i] - tb.gamma / h * mw0[i]).collect();
+            let mut r23: Vec<f64> = (0..n)
+                .map(|i| g[1][i] - (tb.alpha * mw1[i] + tb.beta * mw2[i]) / h)
+                .chain((0..n).map(|i| g[2][i] - (-tb.beta * mw1[i] + tb.alpha * mw2[i]) / h))
+                .collect();
+            if !self.lu1.solve(&mut r1) || !self.lu2.solve(&mut r23) {
+                return self.newton_failed(h);
+            }
+            newt += 1;
+            self.stats.newton_iterations += 1;
+            let mut sum = 0.0;
+            for i in 0..n {
+                sum += (r1[i] / scal[i]).powi(2) + (r23[i] / scal[i]).powi(2) + (r23[n + i] / scal[i]).powi(2);
+            }
+            let dyno = (sum / (3 * n) as f64).sqrt();
+            if newt > 1 && newt < NIT {
+                theta = dyno / dyno_old;
+                if theta >= 0.99 {
+                    return self.newton_failed(h);
+                }
+                faccon = theta / (1.0 - theta);
+                let dyth = faccon * dyno * theta.powi((NIT - 1 - newt) as i32) / fnewt;
+                if dyth >= 1.0 {
+                    let qnewt = dyth.clamp(1e-4, 20.0);
+                    let hhfac = 0.8 * qnewt.powf(-1.0 / (4.0 + (NIT - 1 - newt) as f64));
+                    self.stats.rejected += 1;
+                    self.need_jac = !self.jac_fresh;
+                    return Ok((false, h * hhfac));
+                }
+            }
+            dyno_old = dyno.max(f64::EPSILON);
+            for i in 0..n {
+                w[0][i] += r1[i];
+                w[1][i] += r23[i];
+                w[2][i] += r23[n + i];
+            }
+            for (s, zs) in z.iter_mut().enumerate() {
+                for i in 0..n {
+                    zs[i] = tb.t[s][0] * w[0][i] + tb.t[s][1] * w[1][i] + tb.t[s][2] * w[2][i];
+                }
+            }
+            if faccon * dyno <= fnewt {
+                break;
+            }
+        }
+        self.faccon = faccon;
+        // Embedded error estimate.
+        let f2: Vec<f64> = (0..n).map(|i| (tb.dd[0] * z[0][i] + tb.dd[1] * z[1][i] + tb.dd[2] * z[2][i]) / h).collect();
+        let mf2 = self.mass_mul(&f2);
+        let mut cont: Vec<f64> = (0..n).map(|i| mf2[i] + self.f0[i]).collect();
+        self.lu1.solve(&mut cont);
+        let scal_new: Vec<f64> =
+            (0..n).map(|i| self.atol + self.rtol * self.y[i].abs().max((self.y[i] + z[2][i]).abs())).collect();
+        let norm = |c: &[f64]| -> f64 {
+            let (mut s, mut k) = (0.0, 0usize);
+            for i in 0..n {
+                if self.mass_diag_idx[i] == 0 {
+                    s += (c[i] / scal_new[i]).powi(2);
+                    k += 1;
+                }
+            }
+            (s / k.max(1) as f64).sqrt().max(1e-10)
+        };
+        let mut err = norm(&cont);
+        if err >= 1.0 && (self.first || self.last_rejected) {
+            let y1: Vec<f64> = (0..n).map(|i| self.y[i] + cont[i]).collect();
+            let mut ft = vec![0.0; n];
+            if p.rhs(self.t, &y1, &mut ft).is_ok() {
+                self.stats.rhs_evaluations += 1;
+                cont = (0..n).map(|i| ft[i] + mf2[i]).collect();
+                self.lu1.solve(&mut cont);
+                err = norm(&cont);
+            }
+        }
+        if !err.is_finite() {
+            return self.newton_failed(h);
+        }
+        let fac = SAFE.min(SAFE * (1 + 2 * NIT) as f64 / (newt + 2 * NIT) as f64);
+        let quot = FACR.max(FACL.min(err.powf(0.25) / fac));
+        let hnew = (h / quot).min(self.max_step);
+        if err < 1.0 {
+            // Accept: y ← y + Z₃, keep the collocation polynomial for extrapolation.
+            let c = tb.c;
+            let mut cc: [Vec<f64>; 3] = std::array::from_fn(|_| vec![0.0; n]);
+            for i in 0..n {
+                let (z1, z2, z3) = (z[0][i], z[1][i], z[2][i]);
+                let ak = (z1 - z2) / (c[0] - c[1]);
+                cc[0][i] = (z2 - z3) / (c[1] - 1.0);
+                let acont3 = (ak - z1 / c[0]) / c[1];
+                cc[1][i] = (ak - cc[0][i]) / (c[0] - 1.0);
+                cc[2][i] = cc[1][i] - acont3;
+                self.y[i] += z3;
+            }
+            self.t += h;
+            self.h_old = h;
+            self.cont = Some(cc);
+            self.first = false;
+            self.last_rejected = false;
+            self.stats.accepted += 1;
+            self.jac_fresh = false;
+            self.need_jac = theta > THET;
+            self.f0_valid = false;
+            if p.accepted(self.t, &mut self.y) {
+                self.cont = None;
+                self.need_jac = true;
+            }
+            Ok((true, hnew))
+        } else {
+            self.stats.rejected += 1;
+            self.last_rejected = true;
+            let hn = if self.first { 0.1 * h } else { hnew };
+            self.need_jac = !self.jac_fresh;
+            Ok((false, hn))
+        }
+    }
+
+    fn newton_failed(&mut self, h: f64) -> Result<(bool, f64), String> {
+        self.stats.rejected += 1;
+        self.last_rejected = true;
+        self.need_jac = !self.jac_fresh;
+        self.cont = None;
+        Ok((false, 0.5 * h))
+    }
+}

@@ -1,0 +1,168 @@
+//! Exact derivatives of element equations by forward-mode AD over the element's local
+//! coordinates. Each kernel seeds the coordinates of the (few) bodies an element touches,
+//! so the cost is independent of the model size and every Jacobian stays sparse.
+
+use super::body::{NQ, h_transpose_times, qdot};
+use super::constraints::ConstraintEl;
+use super::forces::ForceEl;
+use super::local::LocalCtx;
+use super::system::System;
+use crate::ad::{Dual, Real};
+
+/// Most bodies one element may touch.
+pub const MAX_ELEMENT_BODIES: usize = 4;
+
+/// Gather the local coordinates of `bodies` from a global vector (6 per body).
+pub fn gather(bodies: &[usize], x: &[f64]) -> Vec<f64> {
+    bodies.iter().flat_map(|&b| x[NQ * b..NQ * b + NQ].iter().copied()).collect()
+}
+
+/// C, C_q (local, row-major neq × 6nb) and C_t of one constraint element.
+pub struct ConstraintFirst {
+    pub c: Vec<f64>,
+    pub cq: Vec<f64>,
+    pub ct: Vec<f64>,
+}
+
+/// C with gradient and Hessian over z = (local q, t); K = 6nb + 1.
+pub struct ConstraintSecond {
+    pub k: usize,
+    pub c: Vec<f64>,
+    /// neq × K.
+    pub grad: Vec<f64>,
+    /// neq × K × K.
+    pub hess: Vec<f64>,
+}
+
+macro_rules! by_bodies {
+    ($nb:expr, $f:ident, $k1:literal, $k2:literal, $k3:literal, $k4:literal, $k0:literal ( $($a:expr),* )) => {
+        match $nb {
+            0 => $f::<$k0>($($a),*),
+            1 => $f::<$k1>($($a),*),
+            2 => $f::<$k2>($($a),*),
+            3 => $f::<$k3>($($a),*),
+            _ => $f::<$k4>($($a),*),
+        }
+    };
+}
+
+/// Constraint values only.
+pub fn constraint_values(sys: &System, el: &ConstraintEl, q: &[f64], t: f64, inputs: &[f64]) -> Vec<f64> {
+    let ql = gather(&el.bodies, q);
+    let ctx = LocalCtx::new(sys, &el.bodies, &ql, &[], &[], t, inputs);
+    let mut out = vec![0.0; el.neq];
+    el.kind.eval(&ctx, &mut out);
+    out
+}
+
+/// First derivatives of a constraint element (Eq. 1b: C_q, C_t).
+pub fn constraint_first(sys: &System, el: &ConstraintEl, q: &[f64], t: f64, inputs: &[f64]) -> ConstraintFirst {
+    by_bodies!(el.bodies.len(), first_k, 7, 13, 19, 25, 1(sys, el, q, t, inputs))
+}
+
+fn first_k<const K: usize>(sys: &System, el: &ConstraintEl, q: &[f64], t: f64, inputs: &[f64]) -> ConstraintFirst {
+    let nq = NQ * el.bodies.len();
+    let ql: Vec<Dual<f64, K>> = gather(&el.bodies, q).iter().enumerate().map(|(k, &v)| Dual::var(v, k)).collect();
+    let ctx = LocalCtx::new(sys, &el.bodies, &ql, &[], &[], Dual::var(t, nq), inputs);
+    let mut out = vec![Dual::zero(); el.neq];
+    el.kind.eval(&ctx, &mut out);
+    let mut r = ConstraintFirst { c: vec![], cq: Vec::with_capacity(el.neq * nq), ct: vec![] };
+    for e in &out {
+        r.c.push(e.v);
+        r.cq.extend_from_slice(&e.d[..nq]);
+        r.ct.push(e.d[nq]);
+    }
+    r
+}
+
+/// Second derivatives of a constraint element (for Ċ_q, (Pᵀλ)_q and the γ of Eq. 1c).
+pub fn constraint_second(sys: &System, el: &ConstraintEl, q: &[f64], t: f64, inputs: &[f64]) -> ConstraintSecond {
+    by_bodies!(el.bodies.len(), second_k, 7, 13, 19, 25, 1(sys, el, q, t, inputs))
+}
+
+fn second_k<const K: usize>(sys: &System, el: &ConstraintEl, q: &[f64], t: f64, inputs: &[f64]) -> ConstraintSecond {
+    let nq = NQ * el.bodies.len();
+    let k = nq + 1;
+    let seed = |v: f64, i: usize| Dual::<Dual<f64, K>, K> {
+        v: Dual::var(v, i),
+        d: std::array::from_fn(|j| if j == i { Dual::one() } else { Dual::zero() }),
+    };
+    let ql: Vec<_> = gather(&el.bodies, q).iter().enumerate().map(|(i, &v)| seed(v, i)).collect();
+    let ctx = LocalCtx::new(sys, &el.bodies, &ql, &[], &[], seed(t, nq), inputs);
+    let mut out = vec![Dual::zero(); el.neq];
+    el.kind.eval(&ctx, &mut out);
+    let mut r = ConstraintSecond { k, c: vec![], grad: vec![], hess: vec![] };
+    for e in &out {
+        r.c.push(e.v.v);
+        r.grad.extend(e.v.d[..k].iter().copied());
+        for a in 0..k {
+            r.hess.extend(e.d[a].d[..k].iter().copied());
+        }
+    }
+    r
+}
+
+/// Generalized forces of one element on its bodies (6 per local body).
+pub fn force_values(sys: &System, el: &ForceEl, q: &[f64], u: &[f64], t: f64, inputs: &[f64]) -> Vec<f64> {
+    let (ql, ul) = (gather(&el.bodies, q), gather(&el.bodies, u));
+    let ctx = LocalCtx::new(sys, &el.bodies, &ql, &ul, &[], t, inputs);
+    let mut out = vec![0.0; NQ * el.bodies.len()];
+    el.generalized(&ctx, &mut out);
+    out
+}
+
+/// Generalized forces and their exact Jacobian: rows 6nb, columns (local q, local u).
+pub fn force_jacobian(
+    sys: &System,
+    el: &ForceEl,
+    q: &[f64],
+    u: &[f64],
+    t: f64,
+    inputs: &[f64],
+) -> (Vec<f64>, Vec<f64>) {
+    by_bodies!(el.bodies.len(), force_jac_k, 13, 25, 37, 49, 1(sys, el, q, u, t, inputs))
+}
+
+fn force_jac_k<const K: usize>(
+    sys: &System,
+    el: &ForceEl,
+    q: &[f64],
+    u: &[f64],
+    t: f64,
+    inputs: &[f64],
+) -> (Vec<f64>, Vec<f64>) {
+    let nq = NQ * el.bodies.len();
+    let ql: Vec<Dual<f64, K>> = gather(&el.bodies, q).iter().enumerate().map(|(k, &v)| Dual::var(v, k)).collect();
+    let ul: Vec<Dual<f64, K>> = gather(&el.bodies, u).iter().enumerate().map(|(k, &v)| Dual::var(v, nq + k)).collect();
+    let ctx = LocalCtx::new(sys, &el.bodies, &ql, &ul, &[], Dual::cst(t), inputs);
+    let mut out = vec![Dual::zero(); nq];
+    el.generalized(&ctx, &mut out);
+    let vals = out.iter().map(|e| e.v).collect();
+    let jac = out.iter().flat_map(|e| e.d[..2 * nq].to_vec()).collect();
+    (vals, jac)
+}
+
+/// ∂q̇_b/∂q_b (6×6, row-major) for one body: only the Euler-angle rows depend on θ, φ.
+pub fn dqdot_dq(q: &[f64], u: &[f64]) -> [f64; 36] {
+    let qd: Vec<Dual<f64, 6>> = q.iter().enumerate().map(|(k, &v)| Dual::var(v, k)).collect();
+    let ud: Vec<Dual<f64, 6>> = u.iter().map(|&v| Dual::cst(v)).collect();
+    let r = qdot(&qd, &ud);
+    std::array::from_fn(|i| r[i / 6].d[i % 6])
+}
+
+/// ∂(Hᵀw)/∂q_b (6×6, row-major) for one body at fixed w.
+pub fn dhtw_dq(q: &[f64], w: &[f64]) -> [f64; 36] {
+    let qd: Vec<Dual<f64, 6>> = q.iter().enumerate().map(|(k, &v)| Dual::var(v, k)).collect();
+    let wd: Vec<Dual<f64, 6>> = w.iter().map(|&v| Dual::cst(v)).collect();
+    let r = h_transpose_times(&qd, &wd);
+    std::array::from_fn(|i| r[i / 6].d[i % 6])
+}
+
+/// Gyroscopic generalized force −ω'×(Jω') of one body and its 3×3 Jacobian in ω'.
+pub fn gyroscopic(j: &[[f64; 3]; 3], w: &[f64]) -> ([f64; 3], [f64; 9]) {
+    use crate::geom::{M3, V3};
+    let wd = V3([Dual::<f64, 3>::var(w[0], 0), Dual::var(w[1], 1), Dual::var(w[2], 2)]);
+    let jw = M3::cst(j).mv(&wd);
+    let g = -wd.cross(&jw);
+    (g.val(), std::array::from_fn(|i| g.0[i / 3].d[i % 3]))
+}

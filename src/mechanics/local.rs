@@ -1,0 +1,122 @@
+//! The local view of an element: the states of the few bodies it touches, as [`Real`]
+//! scalars (f64, or dual numbers seeded on those bodies' coordinates), and the
+//! [`ExprEnv`] that expressions read.
+
+use super::body::{NQ, body_frame};
+use super::system::System;
+use crate::ad::Real;
+use crate::geom::{M3, V3};
+use crate::model::expr::{ElementRef, ExprEnv, LoadFn, MarkerId, Pose, Twist};
+
+/// State of one body as seen by an element.
+#[derive(Clone, Copy, Debug)]
+pub struct LocalBody<T: Real> {
+    /// CM position (ground).
+    pub r: V3<T>,
+    /// Rotation (columns = body axes in ground).
+    pub a: M3<T>,
+    /// CM velocity (ground).
+    pub v: V3<T>,
+    /// Angular velocity, body axes.
+    pub w: V3<T>,
+    /// CM acceleration (ground).
+    pub acc: V3<T>,
+    /// Angular acceleration, body axes.
+    pub wdot: V3<T>,
+}
+
+/// Element-local evaluation context.
+pub struct LocalCtx<'a, T: Real> {
+    pub sys: &'a System,
+    /// Global indices of the bodies this context holds, in local order.
+    pub ids: &'a [usize],
+    pub bodies: Vec<LocalBody<T>>,
+    pub t: T,
+    pub inputs: &'a [f64],
+    /// Element loads for `fx(...)` (outputs only); `None` reads as NaN.
+    pub loads: Option<&'a dyn Fn(LoadFn, ElementRef) -> f64>,
+}
+
+impl<'a, T: Real> LocalCtx<'a, T> {
+    /// Build from local coordinates `q` (6 per body), velocities `u` and accelerations
+    /// `udot` (each 6 per body, may be empty = zero).
+    pub fn new(sys: &'a System, ids: &'a [usize], q: &[T], u: &[T], udot: &[T], t: T, inputs: &'a [f64]) -> Self {
+        let bodies = ids
+            .iter()
+            .enumerate()
+            .map(|(k, &b)| {
+                let (r, a) = body_frame(&q[NQ * k..NQ * k + NQ], &sys.r0[b]);
+                let get = |x: &[T], o: usize| {
+                    if x.is_empty() { V3::zero() } else { V3([x[NQ * k + o], x[NQ * k + o + 1], x[NQ * k + o + 2]]) }
+                };
+                LocalBody { r, a, v: get(u, 0), w: get(u, 3), acc: get(udot, 0), wdot: get(udot, 3) }
+            })
+            .collect();
+        LocalCtx { sys, ids, bodies, t, inputs, loads: None }
+    }
+
+    /// Local index of global body `b`.
+    pub fn local(&self, b: usize) -> usize {
+        self.ids.iter().position(|&x| x == b).expect("element touches body")
+    }
+
+    /// Body (local) of marker `m`, or None for ground.
+    pub fn marker_body(&self, m: MarkerId) -> Option<&LocalBody<T>> {
+        self.sys.markers[m].body.map(|b| &self.bodies[self.local(b)])
+    }
+
+    /// Offset of marker `m` from its body's CM, body axes.
+    fn offset(&self, m: MarkerId) -> V3<T> {
+        V3::cst(self.sys.markers[m].s)
+    }
+}
+
+impl<T: Real> ExprEnv<T> for LocalCtx<'_, T> {
+    fn time(&self) -> T {
+        self.t
+    }
+    fn param(&self, i: usize) -> T {
+        T::cst(self.sys.params[i])
+    }
+    fn input(&self, i: usize) -> T {
+        T::cst(self.inputs[i])
+    }
+    fn variable(&self, _i: usize) -> T {
+        T::cst(f64::NAN)
+    }
+    fn diff(&self, _i: usize) -> T {
+        T::cst(f64::NAN)
+    }
+    fn diff_dot(&self, _i: usize) -> T {
+        T::cst(f64::NAN)
+    }
+    fn pose(&self, m: MarkerId) -> Pose<T> {
+        let g = &self.sys.markers[m];
+        match self.marker_body(m) {
+            None => Pose { p: V3::cst(g.s), r: M3::cst(&g.rot) },
+            Some(b) => Pose { p: b.r + b.a.mv(&self.offset(m)), r: b.a.mm(&M3::cst(&g.rot)) },
+        }
+    }
+    fn twist(&self, m: MarkerId) -> Twist<T> {
+        match self.marker_body(m) {
+            None => Twist { v: V3::zero(), w: V3::zero() },
+            Some(b) => {
+                let s = self.offset(m);
+                Twist { v: b.v + b.a.mv(&b.w.cross(&s)), w: b.a.mv(&b.w) }
+            }
+        }
+    }
+    fn accel(&self, m: MarkerId) -> Twist<T> {
+        match self.marker_body(m) {
+            None => Twist { v: V3::zero(), w: V3::zero() },
+            Some(b) => {
+                let s = self.offset(m);
+                let rel = b.wdot.cross(&s) + b.w.cross(&b.w.cross(&s));
+                Twist { v: b.acc + b.a.mv(&rel), w: b.a.mv(&b.wdot) }
+            }
+        }
+    }
+    fn load(&self, f: LoadFn, e: ElementRef) -> T {
+        T::cst(self.loads.map_or(f64::NAN, |l| l(f, e)))
+    }
+}

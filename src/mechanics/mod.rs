@@ -1,0 +1,13 @@
+//! Mechanics: bodies, markers, joints and forces; mass matrix M, constraints C and their
+//! Jacobians, generalized forces Q and the kinematic map T (Eq. 1, 12, 13a–13e).
+//! Every element is evaluated generically over [`crate::ad::Real`]; derivatives come
+//! from [`crate::ad::Dual`] numbers through the kernels in [`kernels`].
+
+pub mod body;
+pub mod constraints;
+pub mod forces;
+pub mod kernels;
+pub mod local;
+pub mod system;
+
+pub use system::{MarkerGeom, System};

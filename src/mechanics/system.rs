@@ -1,0 +1,265 @@
+//! The mechanical system built from a [`Model`]: numbers evaluated, elements indexed,
+//! coordinates laid out (q, u: 6 per body).
+//!
+//! One `System` belongs to one simulation: besides the model's constants it holds the
+//! per-body reference frames R0 of the Euler angles, which the integrator re-chooses when
+//! a body nears the 3-1-3 singularity (θ = 0 or π).
+
+use super::body::NQ;
+use super::constraints::{ConstraintEl, ConstraintKind, VelocityIc};
+use super::forces::{ForceEl, ForceKind};
+use super::kernels::MAX_ELEMENT_BODIES;
+use crate::geom::{M3, euler313_from_matrix, rot_x};
+use crate::model::expr::{Expr, deps};
+use crate::model::{JointType, Model, MotionDof, Orientation, SpringType};
+
+/// A marker's fixed geometry: offset `s` and rotation relative to its body (or ground).
+#[derive(Clone, Debug)]
+pub struct MarkerGeom {
+    pub body: Option<usize>,
+    pub s: [f64; 3],
+    pub rot: [[f64; 3]; 3],
+}
+
+/// Mass properties of a body.
+#[derive(Clone, Debug)]
+pub struct BodyProps {
+    pub name: String,
+    pub mass: f64,
+    /// Inertia about the CM, body axes.
+    pub inertia: [[f64; 3]; 3],
+}
+
+/// The assembled mechanical system.
+#[derive(Clone, Debug)]
+pub struct System {
+    pub params: Vec<f64>,
+    pub gravity: [f64; 3],
+    pub bodies: Vec<BodyProps>,
+    pub markers: Vec<MarkerGeom>,
+    /// Reference frame of each body's Euler angles (A = R0 · R313(e)).
+    pub r0: Vec<[[f64; 3]; 3]>,
+    /// Holonomic constraints (Eq. 1a), rows laid out consecutively.
+    pub constraints: Vec<ConstraintEl>,
+    /// Number of constraint equations m.
+    pub m: usize,
+    /// Exact position initial conditions (assembly only), rows after the m constraints.
+    pub ic_constraints: Vec<ConstraintEl>,
+    /// Exact velocity initial conditions.
+    pub ic_velocities: Vec<VelocityIc>,
+    pub forces: Vec<ForceEl>,
+    pub output_names: Vec<String>,
+    pub outputs: Vec<Expr>,
+    /// Initial (unassembled) coordinates and velocities from the model file.
+    pub q_init: Vec<f64>,
+    pub u_init: Vec<f64>,
+}
+
+/// Rotation matrix of an orientation attribute (columns = frame axes in owner axes).
+pub fn orientation_matrix(o: &Orientation) -> [[f64; 3]; 3] {
+    crate::model::parse::rotation(o)
+}
+
+/// Angles (0, π/2, 0): far from the 3-1-3 singularity; R0 is chosen so a body starts there.
+pub const FAR_FROM_SINGULAR: [f64; 3] = [0.0, std::f64::consts::FRAC_PI_2, 0.0];
+
+/// R0 such that R0 · R313(FAR_FROM_SINGULAR) = `a`.
+pub fn rebased_reference(a: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
+    M3::cst(a).mm(&rot_x(std::f64::consts::FRAC_PI_2).t()).val()
+}
+
+impl System {
+    /// Build the system from a validated model.
+    pub fn from_model(model: &Model) -> Result<System, String> {
+        let params: Vec<f64> = model.parameters.iter().map(|p| p.value.value).collect();
+        let nb = model.bodies.len();
+        let mut bodies = Vec::with_capacity(nb);
+        let (mut q_init, mut u_init, mut r0) = (vec![0.0; NQ * nb], vec![0.0; NQ * nb], Vec::with_capacity(nb));
+        for (b, body) in model.bodies.iter().enumerate() {
+            let i = body.inertia.values();
+            let inertia = if i.len() == 6 {
+                [[i[0], i[3], i[4]], [i[3], i[1], i[5]], [i[4], i[5], i[2]]]
+            } else {
+                [[i[0], 0.0, 0.0], [0.0, i[1], 0.0], [0.0, 0.0, i[2]]]
+            };
+            bodies.push(BodyProps { name: body.name.clone(), mass: body.mass.value, inertia });
+            let a = orientation_matrix(&body.orientation);
+            r0.push(rebased_reference(&a));
+            let p = body.position.v3();
+            q_init[NQ * b..NQ * b + 3].copy_from_slice(&p);
+            q_init[NQ * b + 3..NQ * b + 6].copy_from_slice(&FAR_FROM_SINGULAR);
+            if let Some(v) = &body.velocity {
+                u_init[NQ * b..NQ * b + 3].copy_from_slice(&v.v3());
+            }
+            if let Some(w) = &body.angular_velocity {
+                // Ground components -> body axes: ω' = Aᵀ ω.
+                let wb = M3::cst(&a).tv(&crate::geom::V3(w.v3()));
+                u_init[NQ * b + 3..NQ * b + 6].copy_from_slice(&wb.0);
+            }
+        }
+        let markers: Vec<MarkerGeom> = model
+            .markers
+            .iter()
+            .map(|m| MarkerGeom { body: m.body, s: m.position.v3(), rot: orientation_matrix(&m.orientation) })
+            .collect();
+        let body_of = |m: usize| markers[m].body;
+        let bodies_of = |ms: &[usize], exprs: &[&Expr]| -> Vec<usize> {
+            let mut v: Vec<usize> = ms.iter().filter_map(|&m| body_of(m)).collect();
+            for e in exprs {
+                v.extend(deps(e).markers.iter().filter_map(|&m| body_of(m)));
+            }
+            v.sort_unstable();
+            v.dedup();
+            v
+        };
+
+        let mut constraints = Vec::new();
+        let mut ic_constraints = Vec::new();
+        let mut ic_velocities = Vec::new();
+        for jt in &model.joints {
+            let bl = bodies_of(&[jt.i, jt.j], &[]);
+            constraints.push(ConstraintEl {
+                name: jt.name.clone(),
+                kind: ConstraintKind::Joint { kind: jt.kind, i: jt.i, j: jt.j },
+                bodies: bl.clone(),
+                neq: jt.kind.equations(),
+                row: 0,
+            });
+            if let Some(a) = &jt.ic_angle {
+                let kind = ConstraintKind::Rotation { i: jt.i, j: jt.j, f: Expr::Num(a.value) };
+                ic_constraints.push(ConstraintEl {
+                    name: format!("{} (ic_angle)", jt.name),
+                    kind,
+                    bodies: bl.clone(),
+                    neq: 1,
+                    row: 0,
+                });
+            }
+            if let Some(d) = &jt.ic_displacement {
+                let kind = ConstraintKind::Translation { i: jt.i, j: jt.j, f: Expr::Num(d.value) };
+                ic_constraints.push(ConstraintEl {
+                    name: format!("{} (ic_displacement)", jt.name),
+                    kind,
+                    bodies: bl.clone(),
+                    neq: 1,
+                    row: 0,
+                });
+            }
+            for (angular, v) in [(true, &jt.ic_angular_speed), (false, &jt.ic_speed)] {
+                if let Some(v) = v {
+                    ic_velocities.push(VelocityIc {
+                        name: jt.name.clone(),
+                        angular,
+                        i: jt.i,
+                        j: jt.j,
+                        value: v.value,
+                        bodies: bl.clone(),
+                    });
+                }
+            }
+        }
+        for mo in &model.motions {
+            let jt = &model.joints[mo.joint];
+            let bl = bodies_of(&[jt.i, jt.j], &[&mo.function]);
+            let (i, j, f) = (jt.i, jt.j, mo.function.clone());
+            let kind = match mo.dof {
+                MotionDof::Rotation => ConstraintKind::Rotation { i, j, f },
+                MotionDof::Translation => ConstraintKind::Translation { i, j, f },
+            };
+            constraints.push(ConstraintEl { name: mo.name.clone(), kind, bodies: bl, neq: 1, row: 0 });
+        }
+        for uc in &model.constraints {
+            let bl = bodies_of(&[], &[&uc.function]);
+            constraints.push(ConstraintEl {
+                name: uc.name.clone(),
+                kind: ConstraintKind::User { f: uc.function.clone() },
+                bodies: bl,
+                neq: 1,
+                row: 0,
+            });
+        }
+        let mut row = 0;
+        for c in constraints.iter_mut().chain(ic_constraints.iter_mut()) {
+            c.row = row;
+            row += c.neq;
+        }
+        let m = constraints.iter().map(|c| c.neq).sum();
+
+        let mut forces = Vec::new();
+        for s in &model.spring_dampers {
+            let kind = ForceKind::SpringDamper {
+                kind: s.kind,
+                i: s.i,
+                j: s.j,
+                k: s.stiffness.value,
+                c: s.damping.value,
+                length: s.length.value,
+                preload: s.preload.value,
+            };
+            forces.push(ForceEl { name: s.name.clone(), kind, bodies: bodies_of(&[s.i, s.j], &[]), angle_ref: 0.0 });
+        }
+        for s in &model.sforces {
+            let kind = ForceKind::Sforce { kind: s.kind, i: s.i, j: s.j, f: s.function.clone() };
+            forces.push(ForceEl {
+                name: s.name.clone(),
+                kind,
+                bodies: bodies_of(&[s.i, s.j], &[&s.function]),
+                angle_ref: 0.0,
+            });
+        }
+        for g in &model.gforces {
+            let mut ms = vec![g.i];
+            ms.extend(g.j);
+            ms.extend(g.frame);
+            let exprs: Vec<&Expr> = g.force.iter().chain(g.torque.iter()).collect();
+            let kind =
+                ForceKind::Gforce { i: g.i, j: g.j, frame: g.frame, force: g.force.clone(), torque: g.torque.clone() };
+            forces.push(ForceEl { name: g.name.clone(), kind, bodies: bodies_of(&ms, &exprs), angle_ref: 0.0 });
+        }
+        for c in &constraints {
+            if c.bodies.len() > MAX_ELEMENT_BODIES {
+                return Err(format!(
+                    "constraint '{}' touches {} bodies (at most {MAX_ELEMENT_BODIES})",
+                    c.name,
+                    c.bodies.len()
+                ));
+            }
+        }
+        for f in &forces {
+            if f.bodies.len() > MAX_ELEMENT_BODIES {
+                return Err(format!(
+                    "force '{}' touches {} bodies (at most {MAX_ELEMENT_BODIES})",
+                    f.name,
+                    f.bodies.len()
+                ));
+            }
+        }
+        let _ = (JointType::Fixed, SpringType::Rotational, euler313_from_matrix::<f64>);
+        Ok(System {
+            params,
+            gravity: model.gravity,
+            bodies,
+            markers,
+            r0,
+            constraints,
+            m,
+            ic_constraints,
+            ic_velocities,
+            forces,
+            output_names: model.outputs.iter().map(|o| o.name.clone()).collect(),
+            outputs: model.outputs.iter().map(|o| o.function.clone()).collect(),
+            q_init,
+            u_init,
+        })
+    }
+
+    /// Number of bodies.
+    pub fn nb(&self) -> usize {
+        self.bodies.len()
+    }
+
+    /// Number of coordinates n (= number of velocities).
+    pub fn n(&self) -> usize {
+        NQ * self.bodies.len()
+    }
+}
