@@ -4,6 +4,7 @@
 //! Data flows one way: [`model`] -> [`mechanics`] -> [`dae`] -> `linearize` -> `fmi`/`cli`.
 
 pub mod ad;
+pub mod cli;
 pub mod dae;
 pub mod geom;
 pub mod mechanics;

@@ -1,1 +1,5 @@
-fn main() {}
+//! The `mbfmu` command: see [`mbfmu::cli`].
+
+fn main() -> std::process::ExitCode {
+    mbfmu::cli::main()
+}

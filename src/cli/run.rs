@@ -1,0 +1,63 @@
+//! `mbfmu run`: the main job on the embedded default model. For now it simulates
+//! `models/double_pendulum.xml` for 2 s and prints a table of its outputs (later: the
+//! eigenvalue table).
+
+use std::io::Write;
+
+use super::CliError;
+use super::simulate::{RunSettings, drive, header};
+use crate::dae::{SimOptions, Simulator};
+use crate::model::parse::load_str;
+
+/// Name under which the embedded model reports errors.
+pub const DEFAULT_MODEL_FILE: &str = "models/double_pendulum.xml";
+/// The embedded default model.
+pub const DEFAULT_MODEL: &str = include_str!("../../models/double_pendulum.xml");
+
+/// Simulated time span [s] and communication step [s] of `mbfmu run`.
+const RUN_END: f64 = 2.0;
+const RUN_STEP: f64 = 0.1;
+
+/// Column width of the table.
+const WIDTH: usize = 14;
+
+/// Simulate the embedded default model and print an aligned table of time and outputs.
+pub fn run(out: &mut dyn Write) -> Result<(), CliError> {
+    let model = load_str(DEFAULT_MODEL, DEFAULT_MODEL_FILE)?;
+    let settings = RunSettings::resolve(&model, Some(RUN_END), Some(RUN_STEP), None)?;
+    let points = settings.points()?;
+    let opts = SimOptions {
+        tol: settings.tol,
+        max_step: None,
+    };
+    let mut sim = Simulator::new(&model, opts, settings.start)?;
+    let io_err = |e| CliError::io("writing to stdout", e);
+
+    writeln!(
+        out,
+        "{}: {} s, step {} s, tolerance {:e}",
+        DEFAULT_MODEL_FILE,
+        settings.end - settings.start,
+        settings.step,
+        settings.tol
+    )
+    .map_err(io_err)?;
+    let names = header(&sim, false);
+    let widths: Vec<usize> = names.iter().map(|n| n.len().max(WIDTH)).collect();
+    let line: Vec<String> = names
+        .iter()
+        .zip(&widths)
+        .map(|(n, &w)| format!("{n:>w$}"))
+        .collect();
+    writeln!(out, "{}", line.join(" ")).map_err(io_err)?;
+    drive(&mut sim, &points, false, |t, values| {
+        let mut cells = vec![format!("{t:>w$.3}", w = widths[0])];
+        cells.extend(
+            values
+                .iter()
+                .zip(&widths[1..])
+                .map(|(v, &w)| format!("{v:>w$.6}")),
+        );
+        writeln!(out, "{}", cells.join(" ")).map_err(io_err)
+    })
+}

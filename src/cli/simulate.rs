@@ -1,0 +1,236 @@
+//! `mbfmu simulate model.xml [--end T] [--step H] [--tol E] [--out result.csv] [--states]`:
+//! simulate and write time, every output (and every q and u) as CSV.
+
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::PathBuf;
+
+use clap::Args;
+
+use super::CliError;
+use crate::dae::{SimOptions, Simulator};
+use crate::model::Model;
+use crate::model::parse::load_file;
+
+/// Defaults when neither the command line nor the model's `<experiment>` gives a value.
+const DEFAULT_STOP: f64 = 1.0;
+const DEFAULT_STEP: f64 = 0.01;
+const DEFAULT_TOL: f64 = 1e-6;
+
+/// Arguments of `mbfmu simulate`.
+#[derive(Clone, Debug, Args)]
+pub struct SimulateArgs {
+    /// Model file (XML, see MODEL_FORMAT.md).
+    pub model: PathBuf,
+    /// End time [s] (default: the model's <experiment stop>, else 1).
+    #[arg(long, value_name = "T", allow_negative_numbers = true)]
+    pub end: Option<f64>,
+    /// Communication step [s] (default: the model's <experiment step>, else 0.01).
+    #[arg(long, value_name = "H", allow_negative_numbers = true)]
+    pub step: Option<f64>,
+    /// Integrator tolerance (default: the model's <experiment tolerance>, else 1e-6).
+    #[arg(long, value_name = "E", allow_negative_numbers = true)]
+    pub tol: Option<f64>,
+    /// Write the CSV to this file instead of stdout.
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
+    /// Also write every coordinate q and velocity u.
+    #[arg(long)]
+    pub states: bool,
+}
+
+/// Start, end, step and tolerance of one simulation run.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RunSettings {
+    pub start: f64,
+    pub end: f64,
+    pub step: f64,
+    pub tol: f64,
+}
+
+impl RunSettings {
+    /// Command-line values first, then the model's `<experiment>`, then the defaults
+    /// (start 0, end 1, step 0.01, tolerance 1e-6). Rejects non-finite or non-positive
+    /// step and tolerance, and an end before the start.
+    pub fn resolve(
+        model: &Model,
+        end: Option<f64>,
+        step: Option<f64>,
+        tol: Option<f64>,
+    ) -> Result<RunSettings, CliError> {
+        let ex = &model.experiment;
+        let s = RunSettings {
+            start: ex.start.unwrap_or(0.0),
+            end: end.or(ex.stop).unwrap_or(DEFAULT_STOP),
+            step: step.or(ex.step).unwrap_or(DEFAULT_STEP),
+            tol: tol.or(ex.tolerance).unwrap_or(DEFAULT_TOL),
+        };
+        if !s.start.is_finite() || !s.end.is_finite() {
+            return Err(CliError::Usage(format!(
+                "start {} and end {} must be finite",
+                s.start, s.end
+            )));
+        }
+        if s.end < s.start {
+            return Err(CliError::Usage(format!(
+                "end time {} is before the start time {}",
+                s.end, s.start
+            )));
+        }
+        if !(s.step.is_finite() && s.step > 0.0) {
+            return Err(CliError::Usage(format!("step {} must be positive", s.step)));
+        }
+        if !(s.tol.is_finite() && s.tol > 0.0) {
+            return Err(CliError::Usage(format!(
+                "tolerance {} must be positive",
+                s.tol
+            )));
+        }
+        Ok(s)
+    }
+
+    /// The communication points, see [`communication_points`].
+    pub fn points(&self) -> Result<Vec<f64>, CliError> {
+        communication_points(self.start, self.end, self.step)
+    }
+}
+
+/// Communication points t_k = start + k·step for k = 0..=round((end − start)/step), each
+/// computed by multiplication (no accumulated round-off). The last point is `end` itself
+/// when it lies within round-off of it. Fails when there would be more than 10⁹ points.
+pub fn communication_points(start: f64, end: f64, step: f64) -> Result<Vec<f64>, CliError> {
+    let ratio = ((end - start) / step).round();
+    if !(0.0..=1e9).contains(&ratio) {
+        return Err(CliError::Usage(format!(
+            "{ratio} communication steps from {start} to {end} with step {step}: \
+             choose a larger step"
+        )));
+    }
+    let n = ratio as usize;
+    let mut points: Vec<f64> = (0..=n).map(|k| start + k as f64 * step).collect();
+    if let Some(last) = points.last_mut()
+        && n > 0
+        && (*last - end).abs() <= 1e-9 * step
+    {
+        *last = end;
+    }
+    Ok(points)
+}
+
+/// Run `sim` through `points` (the first is its current time), calling `row(t, values)` at
+/// each point with the outputs followed, when `with_states`, by the states.
+pub fn drive(
+    sim: &mut Simulator,
+    points: &[f64],
+    with_states: bool,
+    mut row: impl FnMut(f64, &[f64]) -> Result<(), CliError>,
+) -> Result<(), CliError> {
+    let mut values = Vec::new();
+    for (k, &t) in points.iter().enumerate() {
+        if k > 0 {
+            sim.advance(t)?;
+        }
+        values.clear();
+        values.extend(sim.outputs()?);
+        if with_states {
+            values.extend(sim.states());
+        }
+        row(t, &values)?;
+    }
+    Ok(())
+}
+
+/// The CSV header: `time`, the output names, then (with states) the state names.
+pub fn header(sim: &Simulator, with_states: bool) -> Vec<String> {
+    let mut names = vec!["time".to_string()];
+    names.extend(sim.output_names());
+    if with_states {
+        names.extend(sim.state_names());
+    }
+    names
+}
+
+/// Write one CSV line; numbers round-trip exactly (`{:.17e}`).
+fn write_csv_row(out: &mut dyn Write, t: f64, values: &[f64]) -> std::io::Result<()> {
+    write!(out, "{t:.17e}")?;
+    for v in values {
+        write!(out, ",{v:.17e}")?;
+    }
+    writeln!(out)
+}
+
+/// Run `mbfmu simulate`; the CSV goes to `--out` or else to `stdout`.
+pub fn simulate(args: &SimulateArgs, stdout: &mut dyn Write) -> Result<(), CliError> {
+    let model = load_file(&args.model)?;
+    let settings = RunSettings::resolve(&model, args.end, args.step, args.tol)?;
+    let points = settings.points()?;
+    let opts = SimOptions {
+        tol: settings.tol,
+        max_step: None,
+    };
+    let mut sim = Simulator::new(&model, opts, settings.start)?;
+
+    let (mut file_out, target) = match &args.out {
+        Some(path) => {
+            let f = File::create(path)
+                .map_err(|e| CliError::io(format!("creating {}", path.display()), e))?;
+            (Some(BufWriter::new(f)), path.display().to_string())
+        }
+        None => (None, "stdout".to_string()),
+    };
+    let mut buffered_stdout;
+    let out: &mut dyn Write = match file_out.as_mut() {
+        Some(f) => f,
+        None => {
+            buffered_stdout = BufWriter::new(stdout);
+            &mut buffered_stdout
+        }
+    };
+    let io_err = |e| CliError::io(format!("writing {target}"), e);
+
+    writeln!(out, "{}", header(&sim, args.states).join(",")).map_err(io_err)?;
+    let result = drive(&mut sim, &points, args.states, |t, values| {
+        write_csv_row(out, t, values).map_err(io_err)
+    });
+    // Keep the rows computed before a failure: flush either way, report the first error.
+    let flushed = out.flush().map_err(io_err);
+    result.and(flushed)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn communication_points_are_multiples_of_the_step_and_end_on_end() {
+        let p = communication_points(0.0, 1.0, 0.1).unwrap();
+        assert_eq!(p.len(), 11);
+        assert_eq!(p[3], 3.0 * 0.1);
+        assert_eq!(p[10], 1.0);
+        let p = communication_points(0.5, 0.5, 0.1).unwrap();
+        assert_eq!(p, vec![0.5]);
+    }
+
+    #[test]
+    fn communication_points_round_a_non_dividing_step() {
+        let p = communication_points(0.0, 1.0, 0.3).unwrap();
+        assert_eq!(p.len(), 4);
+        assert!((p[3] - 0.9).abs() < 1e-15);
+    }
+
+    #[test]
+    fn too_many_communication_points_is_a_usage_error() {
+        let e = communication_points(0.0, 1e12, 1e-3).unwrap_err();
+        assert_eq!(e.exit_code(), 2);
+    }
+
+    #[test]
+    fn csv_numbers_round_trip() {
+        let mut buf = Vec::new();
+        let x = 0.1 + 0.2;
+        write_csv_row(&mut buf, 1.0 / 3.0, &[x, -1e-300]).unwrap();
+        let line = String::from_utf8(buf).unwrap();
+        let f: Vec<f64> = line.trim().split(',').map(|s| s.parse().unwrap()).collect();
+        assert_eq!(f, vec![1.0 / 3.0, x, -1e-300]);
+    }
+}

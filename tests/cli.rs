@@ -1,0 +1,239 @@
+//! The `mbfmu` command as a user meets it: exit codes, error format, CSV layout, and the
+//! example models. Engine-dependent checks run in full once the engine simulates; until
+//! then an engine failure must still be a clean `error: ...` with exit code 1.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+
+use mbfmu::model::load_file;
+
+fn mbfmu(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_mbfmu"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .stdin(Stdio::null())
+        .output()
+        .expect("the mbfmu binary runs")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+/// Every model in `models/`, with the degrees of freedom its header comment states.
+const MODELS: &[(&str, isize)] = &[
+    ("double_pendulum", 2),
+    ("fourbar", 1),
+    ("pendulum", 1),
+    ("slider_crank", 0),
+    ("spinning_top", 3),
+    ("spring_mass_damper", 1),
+    ("torque_free_body", 6),
+];
+
+fn model_path(name: &str) -> String {
+    format!("models/{name}.xml")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli-tests");
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+/// A `file:line:col: element 'name': what` line.
+fn is_located_model_error(line: &str, file: &str) -> bool {
+    let Some(rest) = line.strip_prefix(file).and_then(|r| r.strip_prefix(':')) else {
+        return false;
+    };
+    let mut parts = rest.splitn(3, ':');
+    let line_no = parts
+        .next()
+        .is_some_and(|s| s.parse::<usize>().is_ok_and(|n| n > 0));
+    let col_no = parts
+        .next()
+        .is_some_and(|s| s.parse::<usize>().is_ok_and(|n| n > 0));
+    let what = parts.next().unwrap_or("");
+    line_no && col_no && what.starts_with(' ') && what.contains(" '") && what.contains("': ")
+}
+
+#[test]
+fn every_example_model_checks_with_the_documented_degrees_of_freedom() {
+    for &(name, dof) in MODELS {
+        let path = model_path(name);
+        let o = mbfmu(&["check", &path]);
+        assert!(o.status.success(), "{path}: {}", stderr(&o));
+        assert!(
+            stdout(&o).contains("degrees of freedom"),
+            "{path}: {}",
+            stdout(&o)
+        );
+        let model = load_file(Path::new(env!("CARGO_MANIFEST_DIR")).join(&path).as_path())
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(model.summary().dof, dof, "{path}");
+        assert!(
+            !model.outputs.is_empty(),
+            "{path} has outputs for the tests"
+        );
+        assert!(
+            model.experiment.stop.is_some(),
+            "{path} has an <experiment>"
+        );
+    }
+}
+
+#[test]
+fn malformed_model_answers_file_line_col_and_exit_code_2() {
+    let bad = scratch("unclosed.xml");
+    std::fs::write(
+        &bad,
+        "<multibody name=\"m\" version=\"1\">\n  <body name=\"b\" mass=\"1\"",
+    )
+    .unwrap();
+    let file = bad.display().to_string();
+    for cmd in ["check", "simulate"] {
+        let o = mbfmu(&[cmd, &file]);
+        assert_eq!(o.status.code(), Some(2), "{cmd}: {}", stderr(&o));
+        let err = stderr(&o);
+        assert!(
+            is_located_model_error(err.trim_end(), &file),
+            "{cmd}: {err}"
+        );
+        assert!(!err.contains("panicked"), "{err}");
+    }
+}
+
+#[test]
+fn semantic_model_error_names_the_element() {
+    let bad = scratch("unknown_marker.xml");
+    std::fs::write(
+        &bad,
+        "<multibody name=\"m\" version=\"1\">\n  <body name=\"b\" mass=\"1\" inertia=\"1 1 1\" position=\"0 0 0\"/>\n  <output name=\"o\" function=\"dx(b.nothere)\"/>\n</multibody>\n",
+    )
+    .unwrap();
+    let file = bad.display().to_string();
+    let o = mbfmu(&["check", &file]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = stderr(&o);
+    assert!(is_located_model_error(err.trim_end(), &file), "{err}");
+    assert!(err.starts_with(&format!("{file}:3:")), "{err}");
+    assert!(err.contains("output 'o'"), "{err}");
+}
+
+#[test]
+fn missing_model_file_is_exit_code_2() {
+    let o = mbfmu(&["check", "models/does_not_exist.xml"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).starts_with("models/does_not_exist.xml:"),
+        "{}",
+        stderr(&o)
+    );
+}
+
+#[test]
+fn bad_command_line_values_are_exit_code_2() {
+    let path = model_path("pendulum");
+    for args in [
+        vec!["simulate", path.as_str(), "--step", "0"],
+        vec!["simulate", path.as_str(), "--step", "-0.1"],
+        vec!["simulate", path.as_str(), "--tol", "0"],
+        vec!["simulate", path.as_str(), "--end", "-1"],
+        vec!["simulate", path.as_str(), "--step", "abc"],
+        vec!["simulate", path.as_str(), "--step", "nan"],
+        vec!["simulate"],
+        vec!["frobnicate"],
+    ] {
+        let o = mbfmu(&args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        assert!(!stderr(&o).contains("panicked"), "{args:?}: {}", stderr(&o));
+    }
+}
+
+/// Exit 0 with a CSV whose header is time + outputs (+ states) and whose time column is
+/// exactly start + k·step (the last one exactly the end); or (engine not ready / failing) exit 1 with `error: ...`.
+fn check_simulation(o: &Output, names: &[String], (start, end, step): (f64, f64, f64), n: usize) {
+    let err = stderr(o);
+    assert!(!err.contains("panicked"), "{err}");
+    match o.status.code() {
+        Some(0) => {
+            let text = stdout(o);
+            let mut lines = text.lines();
+            let header: Vec<&str> = lines.next().expect("a header").split(',').collect();
+            assert_eq!(header[0], "time");
+            assert_eq!(&header[1..=names.len()], names);
+            let rows: Vec<Vec<f64>> = lines
+                .map(|l| l.split(',').map(|x| x.parse().expect("a number")).collect())
+                .collect();
+            assert_eq!(rows.len(), n + 1);
+            for (k, row) in rows.iter().enumerate() {
+                assert_eq!(row.len(), header.len());
+                assert!(row.iter().all(|x| x.is_finite()));
+                let t = if k == n { end } else { start + k as f64 * step };
+                assert_eq!(row[0], t, "time of row {k}");
+            }
+        }
+        Some(1) => assert!(err.starts_with("error: "), "{err}"),
+        other => panic!("exit {other:?}: {err}"),
+    }
+}
+
+#[test]
+fn simulate_writes_time_and_every_output_or_fails_cleanly() {
+    for &(name, _) in MODELS {
+        let path = model_path(name);
+        let model = load_file(Path::new(env!("CARGO_MANIFEST_DIR")).join(&path).as_path()).unwrap();
+        let names: Vec<String> = model.outputs.iter().map(|o| o.name.clone()).collect();
+        let o = mbfmu(&["simulate", &path, "--end", "0.2", "--step", "0.05"]);
+        check_simulation(&o, &names, (0.0, 0.2, 0.05), 4);
+    }
+}
+
+#[test]
+fn simulate_with_out_writes_the_same_csv_to_a_file() {
+    let path = model_path("spring_mass_damper");
+    let out = scratch("smd.csv");
+    let _ = std::fs::remove_file(&out);
+    let out_s = out.display().to_string();
+    let args = [
+        "simulate", &path, "--end", "0.1", "--step", "0.05", "--states", "--out", &out_s,
+    ];
+    let o = mbfmu(&args);
+    if o.status.success() {
+        assert!(stdout(&o).is_empty());
+        let csv = std::fs::read_to_string(&out).unwrap();
+        let header = csv.lines().next().unwrap();
+        assert!(
+            header.starts_with("time,x,x_exact,x_err,spring_force"),
+            "{header}"
+        );
+        assert!(
+            header.split(',').count() > 5,
+            "--states adds q and u: {header}"
+        );
+        assert_eq!(csv.lines().count(), 4);
+    } else {
+        assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    }
+}
+
+#[test]
+fn run_prints_a_table_of_the_default_model_or_fails_cleanly() {
+    let o = mbfmu(&["run"]);
+    let err = stderr(&o);
+    assert!(!err.contains("panicked"), "{err}");
+    match o.status.code() {
+        Some(0) => {
+            let text = stdout(&o);
+            assert!(text.contains("theta1") && text.contains("theta2"), "{text}");
+            // title, header, 21 rows (t = 0, 0.1, ..., 2).
+            assert_eq!(text.lines().count(), 23, "{text}");
+        }
+        Some(1) => assert!(err.starts_with("error: "), "{err}"),
+        other => panic!("exit {other:?}: {err}"),
+    }
+}
