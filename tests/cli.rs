@@ -51,12 +51,8 @@ fn is_located_model_error(line: &str, file: &str) -> bool {
         return false;
     };
     let mut parts = rest.splitn(3, ':');
-    let line_no = parts
-        .next()
-        .is_some_and(|s| s.parse::<usize>().is_ok_and(|n| n > 0));
-    let col_no = parts
-        .next()
-        .is_some_and(|s| s.parse::<usize>().is_ok_and(|n| n > 0));
+    let line_no = parts.next().is_some_and(|s| s.parse::<usize>().is_ok_and(|n| n > 0));
+    let col_no = parts.next().is_some_and(|s| s.parse::<usize>().is_ok_and(|n| n > 0));
     let what = parts.next().unwrap_or("");
     line_no && col_no && what.starts_with(' ') && what.contains(" '") && what.contains("': ")
 }
@@ -67,42 +63,25 @@ fn every_example_model_checks_with_the_documented_degrees_of_freedom() {
         let path = model_path(name);
         let o = mbfmu(&["check", &path]);
         assert!(o.status.success(), "{path}: {}", stderr(&o));
-        assert!(
-            stdout(&o).contains("degrees of freedom"),
-            "{path}: {}",
-            stdout(&o)
-        );
-        let model = load_file(Path::new(env!("CARGO_MANIFEST_DIR")).join(&path).as_path())
-            .unwrap_or_else(|e| panic!("{e}"));
+        assert!(stdout(&o).contains("degrees of freedom"), "{path}: {}", stdout(&o));
+        let model =
+            load_file(Path::new(env!("CARGO_MANIFEST_DIR")).join(&path).as_path()).unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(model.summary().dof, dof, "{path}");
-        assert!(
-            !model.outputs.is_empty(),
-            "{path} has outputs for the tests"
-        );
-        assert!(
-            model.experiment.stop.is_some(),
-            "{path} has an <experiment>"
-        );
+        assert!(!model.outputs.is_empty(), "{path} has outputs for the tests");
+        assert!(model.experiment.stop.is_some(), "{path} has an <experiment>");
     }
 }
 
 #[test]
 fn malformed_model_answers_file_line_col_and_exit_code_2() {
     let bad = scratch("unclosed.xml");
-    std::fs::write(
-        &bad,
-        "<multibody name=\"m\" version=\"1\">\n  <body name=\"b\" mass=\"1\"",
-    )
-    .unwrap();
+    std::fs::write(&bad, "<multibody name=\"m\" version=\"1\">\n  <body name=\"b\" mass=\"1\"").unwrap();
     let file = bad.display().to_string();
     for cmd in ["check", "simulate"] {
         let o = mbfmu(&[cmd, &file]);
         assert_eq!(o.status.code(), Some(2), "{cmd}: {}", stderr(&o));
         let err = stderr(&o);
-        assert!(
-            is_located_model_error(err.trim_end(), &file),
-            "{cmd}: {err}"
-        );
+        assert!(is_located_model_error(err.trim_end(), &file), "{cmd}: {err}");
         assert!(!err.contains("panicked"), "{err}");
     }
 }
@@ -128,11 +107,7 @@ fn semantic_model_error_names_the_element() {
 fn missing_model_file_is_exit_code_2() {
     let o = mbfmu(&["check", "models/does_not_exist.xml"]);
     assert_eq!(o.status.code(), Some(2));
-    assert!(
-        stderr(&o).starts_with("models/does_not_exist.xml:"),
-        "{}",
-        stderr(&o)
-    );
+    assert!(stderr(&o).starts_with("models/does_not_exist.xml:"), "{}", stderr(&o));
 }
 
 #[test]
@@ -166,9 +141,8 @@ fn check_simulation(o: &Output, names: &[String], (start, end, step): (f64, f64,
             let header: Vec<&str> = lines.next().expect("a header").split(',').collect();
             assert_eq!(header[0], "time");
             assert_eq!(&header[1..=names.len()], names);
-            let rows: Vec<Vec<f64>> = lines
-                .map(|l| l.split(',').map(|x| x.parse().expect("a number")).collect())
-                .collect();
+            let rows: Vec<Vec<f64>> =
+                lines.map(|l| l.split(',').map(|x| x.parse().expect("a number")).collect()).collect();
             assert_eq!(rows.len(), n + 1);
             for (k, row) in rows.iter().enumerate() {
                 assert_eq!(row.len(), header.len());
@@ -199,22 +173,14 @@ fn simulate_with_out_writes_the_same_csv_to_a_file() {
     let out = scratch("smd.csv");
     let _ = std::fs::remove_file(&out);
     let out_s = out.display().to_string();
-    let args = [
-        "simulate", &path, "--end", "0.1", "--step", "0.05", "--states", "--out", &out_s,
-    ];
+    let args = ["simulate", &path, "--end", "0.1", "--step", "0.05", "--states", "--out", &out_s];
     let o = mbfmu(&args);
     if o.status.success() {
         assert!(stdout(&o).is_empty());
         let csv = std::fs::read_to_string(&out).unwrap();
         let header = csv.lines().next().unwrap();
-        assert!(
-            header.starts_with("time,x,x_exact,x_err,spring_force"),
-            "{header}"
-        );
-        assert!(
-            header.split(',').count() > 5,
-            "--states adds q and u: {header}"
-        );
+        assert!(header.starts_with("time,x,x_exact,x_err,spring_force"), "{header}");
+        assert!(header.split(',').count() > 5, "--states adds q and u: {header}");
         assert_eq!(csv.lines().count(), 4);
     } else {
         assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));

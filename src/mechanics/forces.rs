@@ -16,7 +16,14 @@ pub enum ForceKind {
     /// Single-component force of an expression.
     Sforce { kind: SpringType, i: MarkerId, j: MarkerId, f: Expr, abase: usize },
     /// General force/torque at i in `frame` axes, reaction on j.
-    Gforce { i: MarkerId, j: Option<MarkerId>, frame: Option<MarkerId>, force: [Expr; 3], torque: [Expr; 3], abase: [usize; 6] },
+    Gforce {
+        i: MarkerId,
+        j: Option<MarkerId>,
+        frame: Option<MarkerId>,
+        force: [Expr; 3],
+        torque: [Expr; 3],
+        abase: [usize; 6],
+    },
 }
 
 /// A force element and the bodies its value depends on or acts on.
@@ -81,7 +88,9 @@ impl ForceEl {
             ForceKind::Gforce { frame, force, torque, abase, .. } => {
                 let r = frame.map(|m| ctx.pose(m).r);
                 let to_ground = |v: V3<T>| r.map_or(v, |r| r.mv(&v));
-                let ev = |k: usize| -> T { if k < 3 { ctx.eval_expr(&force[k], abase[k]) } else { ctx.eval_expr(&torque[k - 3], abase[k]) } };
+                let ev = |k: usize| -> T {
+                    if k < 3 { ctx.eval_expr(&force[k], abase[k]) } else { ctx.eval_expr(&torque[k - 3], abase[k]) }
+                };
                 let f = to_ground(V3([ev(0), ev(1), ev(2)]));
                 let t = to_ground(V3([ev(3), ev(4), ev(5)]));
                 Load { force: f, torque: t }

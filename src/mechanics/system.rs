@@ -210,7 +210,8 @@ impl System {
             forces.push(ForceEl { name: s.name.clone(), kind, bodies: bodies_of(&[s.i, s.j], &[]), angle_ref: 0.0 });
         }
         for s in &model.sforces {
-            let kind = ForceKind::Sforce { kind: s.kind, i: s.i, j: s.j, f: s.function.clone(), abase: alloc(&s.function) };
+            let kind =
+                ForceKind::Sforce { kind: s.kind, i: s.i, j: s.j, f: s.function.clone(), abase: alloc(&s.function) };
             forces.push(ForceEl {
                 name: s.name.clone(),
                 kind,
@@ -224,8 +225,14 @@ impl System {
             ms.extend(g.frame);
             let exprs: Vec<&Expr> = g.force.iter().chain(g.torque.iter()).collect();
             let abase = [0, 1, 2, 3, 4, 5].map(|k| alloc(exprs[k]));
-            let kind =
-                ForceKind::Gforce { i: g.i, j: g.j, frame: g.frame, force: g.force.clone(), torque: g.torque.clone(), abase };
+            let kind = ForceKind::Gforce {
+                i: g.i,
+                j: g.j,
+                frame: g.frame,
+                force: g.force.clone(),
+                torque: g.torque.clone(),
+                abase,
+            };
             forces.push(ForceEl { name: g.name.clone(), kind, bodies: bodies_of(&ms, &exprs), angle_ref: 0.0 });
         }
         for c in &constraints {
