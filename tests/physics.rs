@@ -176,7 +176,7 @@ fn output_does_not_depend_on_the_communication_step() {
     let mut fine_at = Vec::new();
     run(&mut fine, 2.0, 0.001, |s, t| {
         let k = (t * 1000.0).round() as usize;
-        if k % 100 == 0 {
+        if k.is_multiple_of(100) {
             fine_at.push(s.outputs().unwrap());
         }
     });

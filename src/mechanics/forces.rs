@@ -20,8 +20,8 @@ pub enum ForceKind {
         i: MarkerId,
         j: Option<MarkerId>,
         frame: Option<MarkerId>,
-        force: [Expr; 3],
-        torque: [Expr; 3],
+        force: Box<[Expr; 3]>,
+        torque: Box<[Expr; 3]>,
         abase: [usize; 6],
     },
 }

@@ -229,8 +229,8 @@ impl System {
                 i: g.i,
                 j: g.j,
                 frame: g.frame,
-                force: g.force.clone(),
-                torque: g.torque.clone(),
+                force: Box::new(g.force.clone()),
+                torque: Box::new(g.torque.clone()),
                 abase,
             };
             forces.push(ForceEl { name: g.name.clone(), kind, bodies: bodies_of(&ms, &exprs), angle_ref: 0.0 });
