@@ -1,10 +1,11 @@
 //! Sparse LU (faer) with the symbolic analysis cached while the sparsity pattern is
 //! unchanged: the pattern is compared entry by entry, numeric values are re-factored.
 
-use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::sparse::linalg::SupernodalThreshold;
+use faer::sparse::linalg::lu::{LuRef, LuSymbolicParams, NumericLu, SymbolicLu, factorize_symbolic_lu};
 use faer::sparse::{Argsort, Pair, SparseColMat, SymbolicSparseColMat};
-use faer::{Mat, MatMut};
+use faer::{Conj, Mat, MatMut, Par};
 
 /// A matrix under construction, as (row, col, value) entries; duplicates are summed.
 #[derive(Clone, Debug, Default)]
@@ -45,13 +46,23 @@ struct Symbolic {
     lu: SymbolicLu<usize>,
 }
 
-/// A square sparse LU factorization that reuses its symbolic analysis.
+/// A square sparse LU factorization that reuses its symbolic analysis and its scratch
+/// memory; sequential (no thread pool is touched inside a host process).
 #[derive(Default)]
 pub struct SparseLu {
     symbolic: Option<Symbolic>,
-    lu: Option<Lu<usize, f64>>,
+    numeric: Option<NumericLu<usize, f64>>,
+    scratch: Option<MemBuffer>,
     /// Number of symbolic analyses performed (for tests and benchmarks).
     pub analyses: usize,
+}
+
+fn supernodal_threshold() -> SupernodalThreshold {
+    match std::env::var("MBFMU_LU").as_deref() {
+        Ok("simplicial") => SupernodalThreshold::FORCE_SIMPLICIAL,
+        Ok("supernodal") => SupernodalThreshold::FORCE_SUPERNODAL,
+        _ => SupernodalThreshold::AUTO,
+    }
 }
 
 impl SparseLu {
@@ -66,42 +77,61 @@ impl SparseLu {
         if !reuse {
             let (mat, argsort) = SymbolicSparseColMat::try_new_from_indices(n, n, &t.idx)
                 .map_err(|e| format!("sparse pattern: {e:?}"))?;
-            let lu = SymbolicLu::try_new(mat.as_ref()).map_err(|e| format!("symbolic LU: {e:?}"))?;
+            let params = LuSymbolicParams { supernodal_flop_ratio_threshold: supernodal_threshold(), ..Default::default() };
+            let lu = factorize_symbolic_lu(mat.as_ref(), params).map_err(|e| format!("symbolic LU: {e:?}"))?;
+            let req = StackReq::any_of(&[
+                lu.factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default()),
+                lu.solve_in_place_scratch::<f64>(1, Par::Seq),
+            ]);
+            self.scratch = Some(MemBuffer::try_new(req).map_err(|_| "out of memory".to_string())?);
             self.symbolic = Some(Symbolic { n, pattern: t.idx.clone(), mat, argsort, lu });
+            self.numeric = Some(NumericLu::new());
             self.analyses += 1;
         }
         let s = self.symbolic.as_ref().expect("symbolic analysis present");
+        let numeric = self.numeric.as_mut().expect("numeric storage present");
+        let scratch = self.scratch.as_mut().expect("scratch present");
         if t.vals.iter().any(|v| !v.is_finite()) {
-            self.lu = None;
+            self.numeric = Some(NumericLu::new());
             return Err("matrix has non-finite entries".into());
         }
         let a = SparseColMat::new_from_argsort(s.mat.clone(), &s.argsort, &t.vals)
             .map_err(|e| format!("sparse values: {e:?}"))?;
-        match Lu::try_new_with_symbolic(s.lu.clone(), a.as_ref()) {
-            Ok(lu) => {
-                self.lu = Some(lu);
-                Ok(())
-            }
+        match s.lu.factorize_numeric_lu(numeric, a.as_ref(), Par::Seq, MemStack::new(scratch), Default::default()) {
+            Ok(_) => Ok(()),
             Err(e) => {
-                self.lu = None;
+                // A failed factorization leaves the numeric part unusable: start afresh.
+                self.numeric = Some(NumericLu::new());
+                self.symbolic = None;
                 Err(format!("singular matrix ({e:?})"))
             }
         }
     }
 
     /// Solve A x = b in place; false if the result is not finite (singular matrix).
-    pub fn solve(&self, b: &mut [f64]) -> bool {
-        let Some(lu) = &self.lu else { return false };
+    pub fn solve(&mut self, b: &mut [f64]) -> bool {
         let n = b.len();
-        let mut m = MatMut::from_column_major_slice_mut(b, n, 1);
-        lu.solve_in_place(m.as_mut());
-        b.iter().all(|v| v.is_finite())
+        let m = MatMut::from_column_major_slice_mut(b, n, 1);
+        self.solve_mat(m)
     }
 
     /// Solve A X = B in place for several right-hand sides (columns of `b`).
-    pub fn solve_many(&self, b: &mut Mat<f64>) -> bool {
-        let Some(lu) = &self.lu else { return false };
-        lu.solve_in_place(b.as_mut());
+    pub fn solve_many(&mut self, b: &mut Mat<f64>) -> bool {
+        self.solve_mat(b.as_mut())
+    }
+
+    fn solve_mat(&mut self, mut b: MatMut<'_, f64>) -> bool {
+        let (Some(s), Some(numeric)) = (&self.symbolic, &self.numeric) else { return false };
+        let req = s.lu.solve_in_place_scratch::<f64>(b.ncols(), Par::Seq);
+        let mut local;
+        let buf = match &mut self.scratch {
+            Some(buf) if b.ncols() == 1 => buf,
+            _ => {
+                local = MemBuffer::new(req);
+                &mut local
+            }
+        };
+        LuRef::new_unchecked(&s.lu, numeric).solve_in_place_with_conj(Conj::No, b.as_mut(), Par::Seq, MemStack::new(buf));
         (0..b.ncols()).all(|j| (0..b.nrows()).all(|i| b[(i, j)].is_finite()))
     }
 }
