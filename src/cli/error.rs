@@ -35,9 +35,6 @@ impl CliError {
 
     /// Wrap an I/O error with what was being done.
     pub fn io(context: impl Into<String>, source: std::io::Error) -> CliError {
-        CliError::Io {
-            context: context.into(),
-            source,
-        }
+        CliError::Io { context: context.into(), source }
     }
 }

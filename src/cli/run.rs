@@ -26,10 +26,7 @@ pub fn run(out: &mut dyn Write) -> Result<(), CliError> {
     let model = load_str(DEFAULT_MODEL, DEFAULT_MODEL_FILE)?;
     let settings = RunSettings::resolve(&model, Some(RUN_END), Some(RUN_STEP), None)?;
     let points = settings.points()?;
-    let opts = SimOptions {
-        tol: settings.tol,
-        max_step: None,
-    };
+    let opts = SimOptions { tol: settings.tol, max_step: None };
     let mut sim = Simulator::new(&model, opts, settings.start)?;
     let io_err = |e| CliError::io("writing to stdout", e);
 
@@ -44,20 +41,11 @@ pub fn run(out: &mut dyn Write) -> Result<(), CliError> {
     .map_err(io_err)?;
     let names = header(&sim, false);
     let widths: Vec<usize> = names.iter().map(|n| n.len().max(WIDTH)).collect();
-    let line: Vec<String> = names
-        .iter()
-        .zip(&widths)
-        .map(|(n, &w)| format!("{n:>w$}"))
-        .collect();
+    let line: Vec<String> = names.iter().zip(&widths).map(|(n, &w)| format!("{n:>w$}")).collect();
     writeln!(out, "{}", line.join(" ")).map_err(io_err)?;
     drive(&mut sim, &points, false, |t, values| {
         let mut cells = vec![format!("{t:>w$.3}", w = widths[0])];
-        cells.extend(
-            values
-                .iter()
-                .zip(&widths[1..])
-                .map(|(v, &w)| format!("{v:>w$.6}")),
-        );
+        cells.extend(values.iter().zip(&widths[1..]).map(|(v, &w)| format!("{v:>w$.6}")));
         writeln!(out, "{}", cells.join(" ")).map_err(io_err)
     })
 }

@@ -66,25 +66,16 @@ impl RunSettings {
             tol: tol.or(ex.tolerance).unwrap_or(DEFAULT_TOL),
         };
         if !s.start.is_finite() || !s.end.is_finite() {
-            return Err(CliError::Usage(format!(
-                "start {} and end {} must be finite",
-                s.start, s.end
-            )));
+            return Err(CliError::Usage(format!("start {} and end {} must be finite", s.start, s.end)));
         }
         if s.end < s.start {
-            return Err(CliError::Usage(format!(
-                "end time {} is before the start time {}",
-                s.end, s.start
-            )));
+            return Err(CliError::Usage(format!("end time {} is before the start time {}", s.end, s.start)));
         }
         if !(s.step.is_finite() && s.step > 0.0) {
             return Err(CliError::Usage(format!("step {} must be positive", s.step)));
         }
         if !(s.tol.is_finite() && s.tol > 0.0) {
-            return Err(CliError::Usage(format!(
-                "tolerance {} must be positive",
-                s.tol
-            )));
+            return Err(CliError::Usage(format!("tolerance {} must be positive", s.tol)));
         }
         Ok(s)
     }
@@ -164,16 +155,12 @@ pub fn simulate(args: &SimulateArgs, stdout: &mut dyn Write) -> Result<(), CliEr
     let model = load_file(&args.model)?;
     let settings = RunSettings::resolve(&model, args.end, args.step, args.tol)?;
     let points = settings.points()?;
-    let opts = SimOptions {
-        tol: settings.tol,
-        max_step: None,
-    };
+    let opts = SimOptions { tol: settings.tol, max_step: None };
     let mut sim = Simulator::new(&model, opts, settings.start)?;
 
     let (mut file_out, target) = match &args.out {
         Some(path) => {
-            let f = File::create(path)
-                .map_err(|e| CliError::io(format!("creating {}", path.display()), e))?;
+            let f = File::create(path).map_err(|e| CliError::io(format!("creating {}", path.display()), e))?;
             (Some(BufWriter::new(f)), path.display().to_string())
         }
         None => (None, "stdout".to_string()),
@@ -189,9 +176,7 @@ pub fn simulate(args: &SimulateArgs, stdout: &mut dyn Write) -> Result<(), CliEr
     let io_err = |e| CliError::io(format!("writing {target}"), e);
 
     writeln!(out, "{}", header(&sim, args.states).join(",")).map_err(io_err)?;
-    let result = drive(&mut sim, &points, args.states, |t, values| {
-        write_csv_row(out, t, values).map_err(io_err)
-    });
+    let result = drive(&mut sim, &points, args.states, |t, values| write_csv_row(out, t, values).map_err(io_err));
     // Keep the rows computed before a failure: flush either way, report the first error.
     let flushed = out.flush().map_err(io_err);
     result.and(flushed)
