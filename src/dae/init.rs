@@ -11,34 +11,28 @@ use crate::mechanics::constraints::ConstraintEl;
 use crate::mechanics::kernels::{constraint_first, gather};
 use crate::mechanics::local::LocalCtx;
 
-/// Constraint values and Jacobian (triplets, rows offset by `row0`) of a set of elements.
+/// Constraint values into `c` and Jacobian entries (row, global column, value) of a set
+/// of elements, rows numbered by the elements' `row` fields.
 fn eval_set(
     sys: &System,
     els: &[ConstraintEl],
     q: &[f64],
     t: f64,
     inputs: &[f64],
-    row0: usize,
     c: &mut [f64],
-    cq: &mut Triplets,
-    col0: usize,
-    transpose_too: bool,
-) {
+) -> Vec<(usize, usize, f64)> {
+    let mut cq = Vec::new();
     for el in els {
         let f = constraint_first(sys, el, q, t, inputs);
         let nql = NQ * el.bodies.len();
         for e in 0..el.neq {
-            let r = row0 + el.row + e;
             c[el.row + e] = f.c[e];
             for a in 0..nql {
-                let g = NQ * el.bodies[a / NQ] + a % NQ;
-                cq.push(r, col0 + g, f.cq[e * nql + a]);
-                if transpose_too {
-                    cq.push(col0 + g, r, f.cq[e * nql + a]);
-                }
+                cq.push((el.row + e, NQ * el.bodies[a / NQ] + a % NQ, f.cq[e * nql + a]));
             }
         }
     }
+    cq
 }
 
 /// Name of the element holding constraint row `row`.
@@ -65,7 +59,10 @@ pub fn assemble_positions(sys: &System, q: &mut [f64], t: f64, inputs: &[f64], t
         for i in 0..n {
             kkt.push(i, i, 1.0);
         }
-        eval_set(sys, &els, q, t, inputs, n, &mut c, &mut kkt, 0, true);
+        for (r, g, v) in eval_set(sys, &els, q, t, inputs, &mut c) {
+            kkt.push(n + r, g, v);
+            kkt.push(g, n + r, v);
+        }
         let worst =
             c.iter().enumerate().fold((0, 0.0f64), |(k, w), (i, v)| if v.abs() > w { (i, v.abs()) } else { (k, w) });
         if !worst.1.is_finite() {
@@ -97,8 +94,7 @@ pub fn assemble_positions(sys: &System, q: &mut [f64], t: f64, inputs: &[f64], t
     }
     let _ = last;
     // Report the worst constraint after the iterations.
-    let mut kkt = Triplets::new();
-    eval_set(sys, &els, q, t, inputs, n, &mut c, &mut kkt, 0, false);
+    eval_set(sys, &els, q, t, inputs, &mut c);
     let worst =
         c.iter().enumerate().fold((0, 0.0f64), |(k, w), (i, v)| if v.abs() > w { (i, v.abs()) } else { (k, w) });
     Err(format!("cannot assemble: constraint {} cannot be met (residual {:.3e})", row_owner(&els, worst.0), worst.1))

@@ -10,7 +10,7 @@ use crate::mechanics::body::{NQ, body_frame};
 use crate::mechanics::local::LocalCtx;
 use crate::mechanics::system::{FAR_FROM_SINGULAR, rebased_reference};
 use crate::model::Model;
-use crate::model::expr::{ElementRef, LoadFn, eval};
+use crate::model::expr::{ElementRef, LoadFn};
 
 /// Engine failure (assembly, integration, evaluation).
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -87,6 +87,7 @@ impl DaeProblem for MultibodyDae {
             }
         }
         let n = self.lay.n;
+        self.record_angles(t, &y[..n], &y[n..2 * n]);
         for k in 0..self.sys.forces.len() {
             let el = &self.sys.forces[k];
             let ql = crate::mechanics::kernels::gather(&el.bodies, &y[..n]);
@@ -96,6 +97,35 @@ impl DaeProblem for MultibodyDae {
             }
         }
         changed
+    }
+}
+
+impl MultibodyDae {
+    /// Store the current value of every angle measure, so expressions stay on its branch.
+    fn record_angles(&mut self, t: f64, q: &[f64], u: &[f64]) {
+        if self.sys.angle_refs.is_empty() {
+            return;
+        }
+        let rec = std::cell::RefCell::new(Vec::new());
+        {
+            let sys = &self.sys;
+            let ids: Vec<usize> = (0..sys.nb()).collect();
+            let mut ctx = LocalCtx::new(sys, &ids, q, u, &[], t, &self.inputs);
+            ctx.record = Some(&rec);
+            for el in &sys.constraints {
+                let mut out = vec![0.0; el.neq];
+                el.kind.eval(&ctx, &mut out);
+            }
+            for el in &sys.forces {
+                el.load(&ctx);
+            }
+            for (e, &b) in sys.outputs.iter().zip(&sys.output_bases) {
+                ctx.eval_expr(e, b);
+            }
+        }
+        for (g, v) in rec.into_inner() {
+            self.sys.angle_refs[g] = v;
+        }
     }
 }
 
@@ -190,7 +220,7 @@ impl Simulator {
         };
         let mut ctx = LocalCtx::new(sys, &ids, self.q(), self.u(), &udot, self.radau.t, &self.dae.inputs);
         ctx.loads = Some(&ctx_loads);
-        Ok(sys.outputs.iter().map(|e| eval(e, &ctx)).collect())
+        Ok(sys.outputs.iter().zip(&sys.output_bases).map(|(e, &b)| ctx.eval_expr(e, b)).collect())
     }
 
     /// Force and torque (ground; torque about the i marker origin) that an element

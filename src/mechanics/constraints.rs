@@ -4,7 +4,7 @@
 use super::local::LocalCtx;
 use crate::ad::Real;
 use crate::model::JointType;
-use crate::model::expr::{Expr, ExprEnv, MarkerId, eval};
+use crate::model::expr::{Expr, ExprEnv, MarkerId};
 
 /// What a constraint element constrains.
 #[derive(Clone, Debug)]
@@ -12,11 +12,11 @@ pub enum ConstraintKind {
     /// A joint between markers i and j (equations in the model format's table).
     Joint { kind: JointType, i: MarkerId, j: MarkerId },
     /// Relative rotation of i about z_j equals f(t): x_i·y_j cos f − x_i·x_j sin f = 0.
-    Rotation { i: MarkerId, j: MarkerId, f: Expr },
+    Rotation { i: MarkerId, j: MarkerId, f: Expr, abase: usize },
     /// Displacement of i along z_j equals f(t): (p_i − p_j)·z_j − f = 0.
-    Translation { i: MarkerId, j: MarkerId, f: Expr },
+    Translation { i: MarkerId, j: MarkerId, f: Expr, abase: usize },
     /// User constraint f(q, t) = 0.
-    User { f: Expr },
+    User { f: Expr, abase: usize },
 }
 
 /// One constraint element: its equations occupy rows `row..row+neq` of C.
@@ -43,18 +43,18 @@ impl ConstraintKind {
     pub fn eval<T: Real>(&self, ctx: &LocalCtx<T>, out: &mut [T]) {
         match self {
             ConstraintKind::Joint { kind, i, j } => joint_equations(*kind, ctx, *i, *j, out),
-            ConstraintKind::Rotation { i, j, f } => {
+            ConstraintKind::Rotation { i, j, f, abase } => {
                 let (pi, pj) = (ctx.pose(*i), ctx.pose(*j));
                 let xi = pi.r.col(0);
-                let fv: T = eval(f, ctx);
+                let fv: T = ctx.eval_expr(f, *abase);
                 out[0] = xi.dot(&pj.r.col(1)) * fv.cos() - xi.dot(&pj.r.col(0)) * fv.sin();
             }
-            ConstraintKind::Translation { i, j, f } => {
+            ConstraintKind::Translation { i, j, f, abase } => {
                 let (pi, pj) = (ctx.pose(*i), ctx.pose(*j));
-                let fv: T = eval(f, ctx);
+                let fv: T = ctx.eval_expr(f, *abase);
                 out[0] = (pi.p - pj.p).dot(&pj.r.col(2)) - fv;
             }
-            ConstraintKind::User { f } => out[0] = eval(f, ctx),
+            ConstraintKind::User { f, abase } => out[0] = ctx.eval_expr(f, *abase),
         }
     }
 }

@@ -6,7 +6,7 @@ use super::local::LocalCtx;
 use crate::ad::Real;
 use crate::geom::V3;
 use crate::model::SpringType;
-use crate::model::expr::{Expr, ExprEnv, MarkerId, eval};
+use crate::model::expr::{Expr, ExprEnv, MarkerId};
 
 /// What a force element is.
 #[derive(Clone, Debug)]
@@ -14,9 +14,16 @@ pub enum ForceKind {
     /// Translational (along the line of sight) or rotational (about z_j) spring-damper.
     SpringDamper { kind: SpringType, i: MarkerId, j: MarkerId, k: f64, c: f64, length: f64, preload: f64 },
     /// Single-component force of an expression.
-    Sforce { kind: SpringType, i: MarkerId, j: MarkerId, f: Expr },
+    Sforce { kind: SpringType, i: MarkerId, j: MarkerId, f: Expr, abase: usize },
     /// General force/torque at i in `frame` axes, reaction on j.
-    Gforce { i: MarkerId, j: Option<MarkerId>, frame: Option<MarkerId>, force: [Expr; 3], torque: [Expr; 3] },
+    Gforce {
+        i: MarkerId,
+        j: Option<MarkerId>,
+        frame: Option<MarkerId>,
+        force: Box<[Expr; 3]>,
+        torque: Box<[Expr; 3]>,
+        abase: [usize; 6],
+    },
 }
 
 /// A force element and the bodies its value depends on or acts on.
@@ -74,15 +81,18 @@ impl ForceEl {
                 };
                 scalar_load(ctx, *kind, *i, *j, s)
             }
-            ForceKind::Sforce { kind, i, j, f } => {
-                let s: T = eval(f, ctx);
+            ForceKind::Sforce { kind, i, j, f, abase } => {
+                let s: T = ctx.eval_expr(f, *abase);
                 scalar_load(ctx, *kind, *i, *j, s)
             }
-            ForceKind::Gforce { frame, force, torque, .. } => {
+            ForceKind::Gforce { frame, force, torque, abase, .. } => {
                 let r = frame.map(|m| ctx.pose(m).r);
                 let to_ground = |v: V3<T>| r.map_or(v, |r| r.mv(&v));
-                let f = to_ground(V3([eval(&force[0], ctx), eval(&force[1], ctx), eval(&force[2], ctx)]));
-                let t = to_ground(V3([eval(&torque[0], ctx), eval(&torque[1], ctx), eval(&torque[2], ctx)]));
+                let ev = |k: usize| -> T {
+                    if k < 3 { ctx.eval_expr(&force[k], abase[k]) } else { ctx.eval_expr(&torque[k - 3], abase[k]) }
+                };
+                let f = to_ground(V3([ev(0), ev(1), ev(2)]));
+                let t = to_ground(V3([ev(3), ev(4), ev(5)]));
                 Load { force: f, torque: t }
             }
         }

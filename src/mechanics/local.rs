@@ -6,7 +6,8 @@ use super::body::{NQ, body_frame};
 use super::system::System;
 use crate::ad::Real;
 use crate::geom::{M3, V3};
-use crate::model::expr::{ElementRef, ExprEnv, LoadFn, MarkerId, Pose, Twist};
+use crate::model::expr::{ElementRef, Expr, ExprEnv, LoadFn, MarkerId, Pose, Twist, eval};
+use std::cell::{Cell, RefCell};
 
 /// State of one body as seen by an element.
 #[derive(Clone, Copy, Debug)]
@@ -35,6 +36,10 @@ pub struct LocalCtx<'a, T: Real> {
     pub inputs: &'a [f64],
     /// Element loads for `fx(...)` (outputs only); `None` reads as NaN.
     pub loads: Option<&'a dyn Fn(LoadFn, ElementRef) -> f64>,
+    /// First global angle slot of the expression being evaluated.
+    angle_base: Cell<usize>,
+    /// When set, every unwrapped angle is recorded as (global slot, value).
+    pub record: Option<&'a RefCell<Vec<(usize, f64)>>>,
 }
 
 impl<'a, T: Real> LocalCtx<'a, T> {
@@ -52,7 +57,13 @@ impl<'a, T: Real> LocalCtx<'a, T> {
                 LocalBody { r, a, v: get(u, 0), w: get(u, 3), acc: get(udot, 0), wdot: get(udot, 3) }
             })
             .collect();
-        LocalCtx { sys, ids, bodies, t, inputs, loads: None }
+        LocalCtx { sys, ids, bodies, t, inputs, loads: None, angle_base: Cell::new(0), record: None }
+    }
+
+    /// Evaluate expression `e` whose angle measures use global slots from `angle_base`.
+    pub fn eval_expr(&self, e: &Expr, angle_base: usize) -> T {
+        self.angle_base.set(angle_base);
+        eval(e, self)
     }
 
     /// Local index of global body `b`.
@@ -118,5 +129,16 @@ impl<T: Real> ExprEnv<T> for LocalCtx<'_, T> {
     }
     fn load(&self, f: LoadFn, e: ElementRef) -> T {
         T::cst(self.loads.map_or(f64::NAN, |l| l(f, e)))
+    }
+    /// Angles stay on the branch nearest their value at the last accepted step.
+    fn unwrap_angle(&self, slot: usize, a: T) -> T {
+        let g = self.angle_base.get() + slot;
+        let r = self.sys.angle_refs.get(g).copied().unwrap_or(f64::NAN);
+        let two_pi = 2.0 * std::f64::consts::PI;
+        let out = if r.is_finite() { a + T::cst(two_pi * ((r - a.val()) / two_pi).round()) } else { a };
+        if let Some(rec) = self.record {
+            rec.borrow_mut().push((g, out.val()));
+        }
+        out
     }
 }

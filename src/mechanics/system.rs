@@ -10,7 +10,7 @@ use super::constraints::{ConstraintEl, ConstraintKind, VelocityIc};
 use super::forces::{ForceEl, ForceKind};
 use super::kernels::MAX_ELEMENT_BODIES;
 use crate::geom::{M3, euler313_from_matrix, rot_x};
-use crate::model::expr::{Expr, deps};
+use crate::model::expr::{Expr, angle_count, deps};
 use crate::model::{JointType, Model, MotionDof, Orientation, SpringType};
 
 /// A marker's fixed geometry: offset `s` and rotation relative to its body (or ground).
@@ -50,6 +50,11 @@ pub struct System {
     pub forces: Vec<ForceEl>,
     pub output_names: Vec<String>,
     pub outputs: Vec<Expr>,
+    /// First angle-unwrapping slot of each output expression.
+    pub output_bases: Vec<usize>,
+    /// Value of every angle measure at the last accepted step (NaN: none yet); expressions
+    /// keep their angles on the branch nearest these, so angles are continuous in time.
+    pub angle_refs: Vec<f64>,
     /// Initial (unassembled) coordinates and velocities from the model file.
     pub q_init: Vec<f64>,
     pub u_init: Vec<f64>,
@@ -113,6 +118,12 @@ impl System {
             v
         };
 
+        let mut slots = 0usize;
+        let mut alloc = |e: &Expr| {
+            let b = slots;
+            slots += angle_count(e);
+            b
+        };
         let mut constraints = Vec::new();
         let mut ic_constraints = Vec::new();
         let mut ic_velocities = Vec::new();
@@ -126,7 +137,7 @@ impl System {
                 row: 0,
             });
             if let Some(a) = &jt.ic_angle {
-                let kind = ConstraintKind::Rotation { i: jt.i, j: jt.j, f: Expr::Num(a.value) };
+                let kind = ConstraintKind::Rotation { i: jt.i, j: jt.j, f: Expr::Num(a.value), abase: 0 };
                 ic_constraints.push(ConstraintEl {
                     name: format!("{} (ic_angle)", jt.name),
                     kind,
@@ -136,7 +147,7 @@ impl System {
                 });
             }
             if let Some(d) = &jt.ic_displacement {
-                let kind = ConstraintKind::Translation { i: jt.i, j: jt.j, f: Expr::Num(d.value) };
+                let kind = ConstraintKind::Translation { i: jt.i, j: jt.j, f: Expr::Num(d.value), abase: 0 };
                 ic_constraints.push(ConstraintEl {
                     name: format!("{} (ic_displacement)", jt.name),
                     kind,
@@ -161,10 +172,10 @@ impl System {
         for mo in &model.motions {
             let jt = &model.joints[mo.joint];
             let bl = bodies_of(&[jt.i, jt.j], &[&mo.function]);
-            let (i, j, f) = (jt.i, jt.j, mo.function.clone());
+            let (i, j, f, abase) = (jt.i, jt.j, mo.function.clone(), alloc(&mo.function));
             let kind = match mo.dof {
-                MotionDof::Rotation => ConstraintKind::Rotation { i, j, f },
-                MotionDof::Translation => ConstraintKind::Translation { i, j, f },
+                MotionDof::Rotation => ConstraintKind::Rotation { i, j, f, abase },
+                MotionDof::Translation => ConstraintKind::Translation { i, j, f, abase },
             };
             constraints.push(ConstraintEl { name: mo.name.clone(), kind, bodies: bl, neq: 1, row: 0 });
         }
@@ -172,7 +183,7 @@ impl System {
             let bl = bodies_of(&[], &[&uc.function]);
             constraints.push(ConstraintEl {
                 name: uc.name.clone(),
-                kind: ConstraintKind::User { f: uc.function.clone() },
+                kind: ConstraintKind::User { f: uc.function.clone(), abase: alloc(&uc.function) },
                 bodies: bl,
                 neq: 1,
                 row: 0,
@@ -199,7 +210,8 @@ impl System {
             forces.push(ForceEl { name: s.name.clone(), kind, bodies: bodies_of(&[s.i, s.j], &[]), angle_ref: 0.0 });
         }
         for s in &model.sforces {
-            let kind = ForceKind::Sforce { kind: s.kind, i: s.i, j: s.j, f: s.function.clone() };
+            let kind =
+                ForceKind::Sforce { kind: s.kind, i: s.i, j: s.j, f: s.function.clone(), abase: alloc(&s.function) };
             forces.push(ForceEl {
                 name: s.name.clone(),
                 kind,
@@ -212,8 +224,15 @@ impl System {
             ms.extend(g.j);
             ms.extend(g.frame);
             let exprs: Vec<&Expr> = g.force.iter().chain(g.torque.iter()).collect();
-            let kind =
-                ForceKind::Gforce { i: g.i, j: g.j, frame: g.frame, force: g.force.clone(), torque: g.torque.clone() };
+            let abase = [0, 1, 2, 3, 4, 5].map(|k| alloc(exprs[k]));
+            let kind = ForceKind::Gforce {
+                i: g.i,
+                j: g.j,
+                frame: g.frame,
+                force: Box::new(g.force.clone()),
+                torque: Box::new(g.torque.clone()),
+                abase,
+            };
             forces.push(ForceEl { name: g.name.clone(), kind, bodies: bodies_of(&ms, &exprs), angle_ref: 0.0 });
         }
         for c in &constraints {
@@ -246,6 +265,8 @@ impl System {
             ic_constraints,
             ic_velocities,
             forces,
+            output_bases: model.outputs.iter().map(|o| alloc(&o.function)).collect(),
+            angle_refs: vec![f64::NAN; slots],
             output_names: model.outputs.iter().map(|o| o.name.clone()).collect(),
             outputs: model.outputs.iter().map(|o| o.function.clone()).collect(),
             q_init,
