@@ -9,6 +9,7 @@
 # the motion is spatial; gravity -z. Each model is simulated for 1 s at tolerance 1e-6
 # (`mbfmu simulate --end 1 --step 0.01 --tol 1e-6`); the table gives N, the wall time
 # and the peak resident memory of the mbfmu process (GNU time; else Python getrusage).
+# BENCH_TIMEOUT=SECONDS stops a run that takes longer (reported as exit 124).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -78,9 +79,13 @@ printf "%6s  %10s  %14s  %s\n" "N" "wall [s]" "peak RSS [MiB]" "status"
 for n in "${sizes[@]}"; do
     model="$tmp/chain$n.xml"
     chain_model "$n" >"$model"
-    read -r wall rss status < <(measure "$bin" simulate "$model" --end 1 --step 0.01 --tol 1e-6)
+    limit=()
+    [ -z "${BENCH_TIMEOUT:-}" ] || limit=(timeout "$BENCH_TIMEOUT")
+    read -r wall rss status < <(measure "${limit[@]}" "$bin" simulate "$model" --end 1 --step 0.01 --tol 1e-6)
     if [ "$status" = 0 ]; then
         note="ok"
+    elif [ "$status" = 124 ] && [ -n "${BENCH_TIMEOUT:-}" ]; then
+        note="stopped after BENCH_TIMEOUT=${BENCH_TIMEOUT} s"
     else
         note="failed (exit $status): $(head -n 1 "$tmp/stderr")"
     fi
