@@ -70,7 +70,8 @@ const NIT: usize = 7;
 const SAFE: f64 = 0.9;
 const FACL: f64 = 5.0;
 const FACR: f64 = 0.125;
-const THET: f64 = 0.001;
+/// Recompute the Jacobian after a step whose Newton contraction rate exceeded this.
+const THET: f64 = 0.05;
 
 impl Radau {
     /// New integrator at (t0, y0) with tolerance `tol` (relative and absolute).
@@ -359,7 +360,10 @@ impl Radau {
                 self.cont = None;
                 self.need_jac = true;
             }
-            Ok((true, hnew))
+            // Keep h (and the factorization) when the change would be small (RADAU5's
+            // quot1/quot2 window): refactoring costs more than a slightly short step.
+            let keep = !self.need_jac && (1.0..=1.2).contains(&(hnew / h));
+            Ok((true, if keep { h } else { hnew }))
         } else {
             self.stats.rejected += 1;
             self.last_rejected = true;

@@ -61,7 +61,7 @@ fn supernodal_threshold() -> SupernodalThreshold {
     match std::env::var("MBFMU_LU").as_deref() {
         Ok("simplicial") => SupernodalThreshold::FORCE_SIMPLICIAL,
         Ok("supernodal") => SupernodalThreshold::FORCE_SUPERNODAL,
-        _ => SupernodalThreshold::AUTO,
+        _ => SupernodalThreshold::FORCE_SUPERNODAL,
     }
 }
 
@@ -77,7 +77,8 @@ impl SparseLu {
         if !reuse {
             let (mat, argsort) = SymbolicSparseColMat::try_new_from_indices(n, n, &t.idx)
                 .map_err(|e| format!("sparse pattern: {e:?}"))?;
-            let params = LuSymbolicParams { supernodal_flop_ratio_threshold: supernodal_threshold(), ..Default::default() };
+            let params =
+                LuSymbolicParams { supernodal_flop_ratio_threshold: supernodal_threshold(), ..Default::default() };
             let lu = factorize_symbolic_lu(mat.as_ref(), params).map_err(|e| format!("symbolic LU: {e:?}"))?;
             let req = StackReq::any_of(&[
                 lu.factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default()),
@@ -131,7 +132,12 @@ impl SparseLu {
                 &mut local
             }
         };
-        LuRef::new_unchecked(&s.lu, numeric).solve_in_place_with_conj(Conj::No, b.as_mut(), Par::Seq, MemStack::new(buf));
+        LuRef::new_unchecked(&s.lu, numeric).solve_in_place_with_conj(
+            Conj::No,
+            b.as_mut(),
+            Par::Seq,
+            MemStack::new(buf),
+        );
         (0..b.ncols()).all(|j| (0..b.nrows()).all(|i| b[(i, j)].is_finite()))
     }
 }
