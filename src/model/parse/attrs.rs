@@ -19,28 +19,48 @@ pub(crate) struct El<'a> {
 /// Split a vector attribute: on commas if there is any, else on white space. Each item
 /// comes with the character offset of its first character.
 pub(crate) fn split_items(s: &str) -> Vec<(usize, &str)> {
-    let mut out = Vec::new();
-    if s.contains(',') {
-        let mut start = 0;
-        for part in s.split(',') {
-            let lead = part.len() - part.trim_start().len();
-            out.push((s[..start + lead].chars().count(), part.trim()));
-            start += part.len() + 1;
-        }
-    } else {
-        let mut item_start: Option<(usize, usize)> = None;
-        for (ci, (b, c)) in s.char_indices().enumerate() {
-            if c.is_whitespace() {
-                if let Some((cs, bs)) = item_start.take() {
-                    out.push((cs, &s[bs..b]));
-                }
-            } else if item_start.is_none() {
-                item_start = Some((ci, b));
+    // Separators count only outside parentheses, so function arguments stay together.
+    let depth_at: Vec<i32> = s
+        .chars()
+        .scan(0i32, |d, c| {
+            let here = *d;
+            match c {
+                '(' => *d += 1,
+                ')' => *d -= 1,
+                _ => {}
             }
+            Some(if c == ')' { here - 1 } else { here })
+        })
+        .collect();
+    let top_comma = s.chars().zip(&depth_at).any(|(c, &d)| c == ',' && d == 0);
+    let is_sep = |c: char, d: i32| d == 0 && if top_comma { c == ',' } else { c.is_whitespace() };
+    let mut out = Vec::new();
+    let mut item: Option<(usize, usize)> = None; // (char index, byte index) of the item start
+    let mut last_end = 0usize; // byte index after the last non-space char of the item
+    fn push<'s>(out: &mut Vec<(usize, &'s str)>, item: Option<(usize, usize)>, end: usize, s: &'s str) {
+        if let Some((ci, bi)) = item {
+            out.push((ci, s[bi..end].trim()));
         }
-        if let Some((cs, bs)) = item_start {
-            out.push((cs, &s[bs..]));
+    }
+    for (ci, ((b, c), &d)) in s.char_indices().zip(&depth_at).enumerate() {
+        if is_sep(c, d) {
+            if top_comma {
+                push(&mut out, item.take().or(Some((ci, b))), b, s);
+            } else {
+                push(&mut out, item.take(), last_end, s);
+            }
+        } else if !c.is_whitespace() {
+            if item.is_none() {
+                item = Some((ci, b));
+            }
+            last_end = b + c.len_utf8();
         }
+    }
+    if top_comma {
+        let n = s.chars().count();
+        push(&mut out, item.take().or(Some((n, s.len()))), s.len(), s);
+    } else {
+        push(&mut out, item.take(), last_end, s);
     }
     out
 }
