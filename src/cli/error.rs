@@ -12,9 +12,9 @@ pub enum CliError {
     /// Bad command-line value (e.g. a negative step).
     #[error("error: {0}")]
     Usage(String),
-    /// Engine failure (assembly, integration, evaluation).
+    /// Engine failure (integration, evaluation).
     #[error("error: {0}")]
-    Engine(#[from] EngineError),
+    Engine(EngineError),
     /// Reading or writing a file or stdout failed.
     #[error("error: {context}: {source}")]
     Io {
@@ -22,6 +22,16 @@ pub enum CliError {
         context: String,
         source: std::io::Error,
     },
+}
+
+impl From<EngineError> for CliError {
+    /// A model the engine cannot set up (e.g. not assemblable) is bad input, located.
+    fn from(e: EngineError) -> Self {
+        match e {
+            EngineError::Model(m) => CliError::Model(m),
+            other => CliError::Engine(other),
+        }
+    }
 }
 
 impl CliError {

@@ -35,15 +35,22 @@ fn eval_set(
     cq
 }
 
-/// Name of the element holding constraint row `row`.
-fn row_owner(els: &[ConstraintEl], row: usize) -> String {
-    els.iter().find(|e| row >= e.row && row < e.row + e.neq).map_or("?".into(), |e| {
-        if e.neq > 1 { format!("'{}' (equation {})", e.name, row - e.row + 1) } else { format!("'{}'", e.name) }
-    })
+/// An initialization failure, located at the constraint element to blame when there is one.
+#[derive(Clone, Debug)]
+pub struct InitError {
+    /// The element and which of its equations (1-based).
+    pub element: Option<(ConstraintEl, usize)>,
+    pub msg: String,
+}
+
+/// An error blamed on the element holding constraint row `row`.
+fn at_row(els: &[ConstraintEl], row: usize, msg: String) -> InitError {
+    let element = els.iter().find(|e| row >= e.row && row < e.row + e.neq).map(|e| (e.clone(), row - e.row + 1));
+    InitError { element, msg }
 }
 
 /// Assemble positions: q closest to `q` (step by step) with C(q, t) = 0 and exact ICs.
-pub fn assemble_positions(sys: &System, q: &mut [f64], t: f64, inputs: &[f64], tol: f64) -> Result<(), String> {
+pub fn assemble_positions(sys: &System, q: &mut [f64], t: f64, inputs: &[f64], tol: f64) -> Result<(), InitError> {
     let n = sys.n();
     let els: Vec<ConstraintEl> = sys.constraints.iter().chain(sys.ic_constraints.iter()).cloned().collect();
     let mr: usize = els.iter().map(|e| e.neq).sum();
@@ -66,26 +73,20 @@ pub fn assemble_positions(sys: &System, q: &mut [f64], t: f64, inputs: &[f64], t
         let worst =
             c.iter().enumerate().fold((0, 0.0f64), |(k, w), (i, v)| if v.abs() > w { (i, v.abs()) } else { (k, w) });
         if !worst.1.is_finite() {
-            return Err(format!("cannot assemble: constraint {} is not finite", row_owner(&els, worst.0)));
+            return Err(at_row(&els, worst.0, "cannot be assembled: its equations are not finite".into()));
         }
         if worst.1 <= tol * scale {
             return Ok(());
         }
-        if let Err(e) = lu.factor(n + mr, &kkt) {
-            return Err(format!(
-                "cannot assemble: constraint Jacobian is singular ({e}); redundant or conflicting constraints near {}",
-                row_owner(&els, worst.0)
-            ));
+        if lu.factor(n + mr, &kkt).is_err() {
+            return Err(at_row(&els, worst.0, redundant(worst.1)));
         }
         let mut rhs = vec![0.0; n + mr];
         for (i, v) in c.iter().enumerate() {
             rhs[n + i] = -v;
         }
         if !lu.solve(&mut rhs) {
-            return Err(format!(
-                "cannot assemble: redundant or conflicting constraints near {}",
-                row_owner(&els, worst.0)
-            ));
+            return Err(at_row(&els, worst.0, redundant(worst.1)));
         }
         for i in 0..n {
             q[i] += rhs[i];
@@ -97,7 +98,19 @@ pub fn assemble_positions(sys: &System, q: &mut [f64], t: f64, inputs: &[f64], t
     eval_set(sys, &els, q, t, inputs, &mut c);
     let worst =
         c.iter().enumerate().fold((0, 0.0f64), |(k, w), (i, v)| if v.abs() > w { (i, v.abs()) } else { (k, w) });
-    Err(format!("cannot assemble: constraint {} cannot be met (residual {:.3e})", row_owner(&els, worst.0), worst.1))
+    Err(at_row(
+        &els,
+        worst.0,
+        format!("cannot be assembled: worst constraint residual {:.3e} after 100 iterations", worst.1),
+    ))
+}
+
+/// Message for a singular assembly step.
+fn redundant(residual: f64) -> String {
+    format!(
+        "cannot be assembled: the constraint Jacobian is singular (redundant or conflicting constraints); \
+         worst residual {residual:.3e} is here"
+    )
 }
 
 /// Consistent velocities: u closest to `u` with P u + C_t = 0 and exact velocity ICs.

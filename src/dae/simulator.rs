@@ -9,13 +9,26 @@ use crate::mechanics::System;
 use crate::mechanics::body::{NQ, body_frame};
 use crate::mechanics::local::LocalCtx;
 use crate::mechanics::system::{FAR_FROM_SINGULAR, rebased_reference};
-use crate::model::Model;
 use crate::model::expr::{ElementRef, LoadFn};
+use crate::model::{Model, ModelError};
 
-/// Engine failure (assembly, integration, evaluation).
+/// Engine failure.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
-#[error("{0}")]
-pub struct EngineError(pub String);
+pub enum EngineError {
+    /// The model cannot be set up as written (e.g. it cannot be assembled), located at the
+    /// element to blame: `file:line:col: element 'name': what is wrong`.
+    #[error("{0}")]
+    Model(ModelError),
+    /// A numerical failure (integration, singular equations).
+    #[error("{0}")]
+    Numeric(String),
+}
+
+impl From<String> for EngineError {
+    fn from(s: String) -> Self {
+        EngineError::Numeric(s)
+    }
+}
 
 /// Integrator options.
 #[derive(Clone, Copy, Debug)]
@@ -142,16 +155,25 @@ impl Simulator {
     /// Build the equations and initialize at `t0` (assembly, consistent velocities,
     /// accelerations and multipliers).
     pub fn new(model: &Model, opts: SimOptions, t0: f64) -> Result<Simulator, EngineError> {
-        let sys = System::from_model(model).map_err(EngineError)?;
+        let sys = System::from_model(model).map_err(EngineError::Numeric)?;
         let inputs: Vec<f64> = model.inputs.iter().map(|i| i.start.value).collect();
         let lay = Layout { n: sys.n(), m: sys.m };
         let mut q = sys.q_init.clone();
         let mut u = sys.u_init.clone();
         let assembly_tol = (opts.tol * 1e-3).max(1e-14);
-        init::assemble_positions(&sys, &mut q, t0, &inputs, assembly_tol).map_err(EngineError)?;
-        init::assemble_velocities(&sys, &q, &mut u, t0, &inputs).map_err(EngineError)?;
+        init::assemble_positions(&sys, &mut q, t0, &inputs, assembly_tol).map_err(|e| match e.element {
+            Some((el, eq)) => EngineError::Model(ModelError {
+                file: model.file.clone(),
+                pos: el.pos,
+                element: el.tag.into(),
+                name: el.name.clone(),
+                msg: if el.neq > 1 { format!("{} (equation {eq} of {})", e.msg, el.neq) } else { e.msg },
+            }),
+            None => EngineError::Numeric(e.msg),
+        })?;
+        init::assemble_velocities(&sys, &q, &mut u, t0, &inputs).map_err(EngineError::Numeric)?;
         let mut acc_lu = SparseLu::new();
-        let (udot, lam) = init::accelerations(&sys, &q, &u, t0, &inputs, &mut acc_lu).map_err(EngineError)?;
+        let (udot, lam) = init::accelerations(&sys, &q, &u, t0, &inputs, &mut acc_lu).map_err(EngineError::Numeric)?;
         let mut y = vec![0.0; lay.dim()];
         y[..lay.n].copy_from_slice(&q);
         y[lay.u()..lay.u() + lay.n].copy_from_slice(&u);
@@ -173,10 +195,10 @@ impl Simulator {
     /// Integrate to `t_end` exactly (the last step lands on it).
     pub fn advance(&mut self, t_end: f64) -> Result<(), EngineError> {
         if t_end < self.radau.t {
-            return Err(EngineError(format!("cannot integrate backwards from {} to {t_end}", self.radau.t)));
+            return Err(EngineError::Numeric(format!("cannot integrate backwards from {} to {t_end}", self.radau.t)));
         }
         self.acc = None;
-        self.radau.advance(&mut self.dae, t_end).map_err(EngineError)
+        self.radau.advance(&mut self.dae, t_end).map_err(EngineError::Numeric)
     }
 
     /// Integrator statistics so far.
@@ -199,7 +221,8 @@ impl Simulator {
             let (q, u) = (self.q().to_vec(), self.u().to_vec());
             let s = &self.dae;
             self.acc = Some(
-                init::accelerations(&s.sys, &q, &u, self.radau.t, &s.inputs, &mut self.acc_lu).map_err(EngineError)?,
+                init::accelerations(&s.sys, &q, &u, self.radau.t, &s.inputs, &mut self.acc_lu)
+                    .map_err(EngineError::Numeric)?,
             );
         }
         Ok(self.acc.clone().expect("just computed"))

@@ -3,8 +3,8 @@
 
 use super::local::LocalCtx;
 use crate::ad::Real;
-use crate::model::JointType;
 use crate::model::expr::{Expr, ExprEnv, MarkerId};
+use crate::model::{JointType, SrcPos};
 
 /// What a constraint element constrains.
 #[derive(Clone, Debug)]
@@ -28,6 +28,9 @@ pub struct ConstraintEl {
     pub bodies: Vec<usize>,
     pub neq: usize,
     pub row: usize,
+    /// The model element it comes from (tag and position), for located messages.
+    pub tag: &'static str,
+    pub pos: SrcPos,
 }
 
 impl ConstraintKind {

@@ -135,6 +135,8 @@ impl System {
                 bodies: bl.clone(),
                 neq: jt.kind.equations(),
                 row: 0,
+                tag: "joint",
+                pos: jt.pos,
             });
             if let Some(a) = &jt.ic_angle {
                 let kind = ConstraintKind::Rotation { i: jt.i, j: jt.j, f: Expr::Num(a.value), abase: 0 };
@@ -144,6 +146,8 @@ impl System {
                     bodies: bl.clone(),
                     neq: 1,
                     row: 0,
+                    tag: "joint",
+                    pos: jt.pos,
                 });
             }
             if let Some(d) = &jt.ic_displacement {
@@ -154,6 +158,8 @@ impl System {
                     bodies: bl.clone(),
                     neq: 1,
                     row: 0,
+                    tag: "joint",
+                    pos: jt.pos,
                 });
             }
             for (angular, v) in [(true, &jt.ic_angular_speed), (false, &jt.ic_speed)] {
@@ -177,7 +183,15 @@ impl System {
                 MotionDof::Rotation => ConstraintKind::Rotation { i, j, f, abase },
                 MotionDof::Translation => ConstraintKind::Translation { i, j, f, abase },
             };
-            constraints.push(ConstraintEl { name: mo.name.clone(), kind, bodies: bl, neq: 1, row: 0 });
+            constraints.push(ConstraintEl {
+                name: mo.name.clone(),
+                kind,
+                bodies: bl,
+                neq: 1,
+                row: 0,
+                tag: "motion",
+                pos: mo.pos,
+            });
         }
         for uc in &model.constraints {
             let bl = bodies_of(&[], &[&uc.function]);
@@ -187,6 +201,8 @@ impl System {
                 bodies: bl,
                 neq: 1,
                 row: 0,
+                tag: "constraint",
+                pos: uc.pos,
             });
         }
         let mut row = 0;
