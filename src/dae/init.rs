@@ -39,13 +39,14 @@ fn eval_set(
 #[derive(Clone, Debug)]
 pub struct InitError {
     /// The element and which of its equations (1-based).
-    pub element: Option<(ConstraintEl, usize)>,
+    pub element: Option<Box<(ConstraintEl, usize)>>,
     pub msg: String,
 }
 
 /// An error blamed on the element holding constraint row `row`.
 fn at_row(els: &[ConstraintEl], row: usize, msg: String) -> InitError {
-    let element = els.iter().find(|e| row >= e.row && row < e.row + e.neq).map(|e| (e.clone(), row - e.row + 1));
+    let element =
+        els.iter().find(|e| row >= e.row && row < e.row + e.neq).map(|e| Box::new((e.clone(), row - e.row + 1)));
     InitError { element, msg }
 }
 

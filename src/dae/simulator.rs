@@ -162,12 +162,12 @@ impl Simulator {
         let mut u = sys.u_init.clone();
         let assembly_tol = (opts.tol * 1e-3).max(1e-14);
         init::assemble_positions(&sys, &mut q, t0, &inputs, assembly_tol).map_err(|e| match e.element {
-            Some((el, eq)) => EngineError::Model(ModelError {
+            Some(b) => EngineError::Model(ModelError {
                 file: model.file.clone(),
-                pos: el.pos,
-                element: el.tag.into(),
-                name: el.name.clone(),
-                msg: if el.neq > 1 { format!("{} (equation {eq} of {})", e.msg, el.neq) } else { e.msg },
+                pos: b.0.pos,
+                element: b.0.tag.into(),
+                name: b.0.name.clone(),
+                msg: if b.0.neq > 1 { format!("{} (equation {} of {})", e.msg, b.1, b.0.neq) } else { e.msg },
             }),
             None => EngineError::Numeric(e.msg),
         })?;
