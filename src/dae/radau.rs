@@ -35,6 +35,8 @@ pub struct Stats {
     pub jacobians: usize,
     pub factorizations: usize,
     pub rhs_evaluations: usize,
+    /// Symbolic sparse-LU analyses: one per matrix while the sparsity pattern is unchanged.
+    pub symbolic_analyses: usize,
 }
 
 /// Integrator state.
@@ -181,6 +183,7 @@ impl Radau {
         self.lu2.factor(2 * n, &e2)?;
         self.h_fact = h;
         self.stats.factorizations += 1;
+        self.stats.symbolic_analyses = self.lu1.analyses + self.lu2.analyses;
         Ok(())
     }
 
