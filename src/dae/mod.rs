@@ -8,4 +8,4 @@ mod radau_tableau;
 mod simulator;
 pub mod sparse;
 
-pub use simulator::{BodyState, EngineError, SimOptions, Simulator};
+pub use simulator::{BodyState, EngineError, SimOptions, SimState, Simulator};

@@ -110,12 +110,18 @@ impl Radau {
         }
     }
 
-    /// Forget extrapolation data and the Jacobian (after y was changed from outside).
+    /// Forget everything but (t, y, h): extrapolation data, Jacobian, factorization and
+    /// Newton history. After a reset the future depends only on (t, y, h), which makes a
+    /// restored state reproduce a run bit for bit.
     pub fn reset(&mut self) {
         self.cont = None;
         self.need_jac = true;
+        self.jac_fresh = false;
+        self.h_fact = f64::NAN;
         self.f0_valid = false;
         self.first = true;
+        self.last_rejected = false;
+        self.faccon = 1.0;
     }
 
     /// Integrate to exactly `t_end`.

@@ -59,11 +59,80 @@ pub struct BodyState {
     pub angular_velocity: [f64; 3],
 }
 
+/// A complete simulation state: restoring it reproduces the run bit for bit.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SimState {
+    pub t: f64,
+    /// Next step size.
+    pub h: f64,
+    /// [q; u; λ; μ].
+    pub y: Vec<f64>,
+    /// Euler-angle reference frames.
+    pub r0: Vec<[[f64; 3]; 3]>,
+    /// Angle-unwrapping references of expressions and rotational springs.
+    pub angle_refs: Vec<f64>,
+    pub spring_refs: Vec<f64>,
+    pub inputs: Vec<f64>,
+    pub slopes: Vec<f64>,
+    pub t_in: f64,
+}
+
+const STATE_MAGIC: &[u8; 8] = b"MBFMUS01";
+
+impl SimState {
+    /// Serialize (little-endian f64 arrays with lengths, behind a magic tag).
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut b = STATE_MAGIC.to_vec();
+        let mut arr = |v: &[f64]| {
+            b.extend_from_slice(&(v.len() as u64).to_le_bytes());
+            for x in v {
+                b.extend_from_slice(&x.to_le_bytes());
+            }
+        };
+        arr(&[self.t, self.h, self.t_in]);
+        arr(&self.y);
+        arr(&self.r0.iter().flatten().flatten().copied().collect::<Vec<f64>>());
+        arr(&self.angle_refs);
+        arr(&self.spring_refs);
+        arr(&self.inputs);
+        arr(&self.slopes);
+        b
+    }
+
+    /// Deserialize what [`SimState::to_bytes`] wrote.
+    pub fn from_bytes(bytes: &[u8]) -> Result<SimState, EngineError> {
+        let bad = || EngineError::Numeric("not a serialized mbfmu state".into());
+        let rest = bytes.strip_prefix(STATE_MAGIC.as_slice()).ok_or_else(bad)?;
+        let mut pos = 0usize;
+        let mut arr = || -> Result<Vec<f64>, EngineError> {
+            let len_bytes = rest.get(pos..pos + 8).ok_or_else(bad)?;
+            let n = u64::from_le_bytes(len_bytes.try_into().map_err(|_| bad())?) as usize;
+            pos += 8;
+            let end = n.checked_mul(8).and_then(|k| k.checked_add(pos)).ok_or_else(bad)?;
+            let data = rest.get(pos..end).ok_or_else(bad)?;
+            pos = end;
+            Ok(data.chunks_exact(8).map(|c| f64::from_le_bytes(c.try_into().expect("8 bytes"))).collect())
+        };
+        let head = arr()?;
+        let y = arr()?;
+        let r0f = arr()?;
+        let (angle_refs, spring_refs, inputs, slopes) = (arr()?, arr()?, arr()?, arr()?);
+        if head.len() != 3 || r0f.len() % 9 != 0 || pos != rest.len() {
+            return Err(bad());
+        }
+        let r0 = r0f.chunks_exact(9).map(|c| [[c[0], c[1], c[2]], [c[3], c[4], c[5]], [c[6], c[7], c[8]]]).collect();
+        Ok(SimState { t: head[0], h: head[1], t_in: head[2], y, r0, angle_refs, spring_refs, inputs, slopes })
+    }
+}
+
 /// The multibody DAE handed to the integrator.
 struct MultibodyDae {
     sys: System,
     lay: Layout,
+    /// Input values at time `t_in`, and their slopes (linear interpolation over a step).
     inputs: Vec<f64>,
+    slopes: Vec<f64>,
+    t_in: f64,
 }
 
 impl DaeProblem for MultibodyDae {
@@ -71,11 +140,11 @@ impl DaeProblem for MultibodyDae {
         self.lay.dim()
     }
     fn rhs(&mut self, t: f64, y: &[f64], f: &mut [f64]) -> Result<(), String> {
-        equations::rhs(&self.sys, self.lay, t, y, &self.inputs, f);
+        equations::rhs(&self.sys, self.lay, t, y, &self.inputs_at(t), f);
         if f.iter().all(|v| v.is_finite()) { Ok(()) } else { Err("non-finite equations".into()) }
     }
     fn jacobian(&mut self, t: f64, y: &[f64], j: &mut Triplets) -> Result<(), String> {
-        equations::jacobian(&self.sys, self.lay, t, y, &self.inputs, j);
+        equations::jacobian(&self.sys, self.lay, t, y, &self.inputs_at(t), j);
         Ok(())
     }
     fn mass(&self, m: &mut Triplets) {
@@ -101,10 +170,11 @@ impl DaeProblem for MultibodyDae {
         }
         let n = self.lay.n;
         self.record_angles(t, &y[..n], &y[n..2 * n]);
+        let inputs = self.inputs_at(t);
         for k in 0..self.sys.forces.len() {
             let el = &self.sys.forces[k];
             let ql = crate::mechanics::kernels::gather(&el.bodies, &y[..n]);
-            let ctx = LocalCtx::new(&self.sys, &el.bodies, &ql, &[], &[], t, &self.inputs);
+            let ctx = LocalCtx::new(&self.sys, &el.bodies, &ql, &[], &[], t, &inputs);
             if let Some(a) = el.angle(&ctx) {
                 self.sys.forces[k].angle_ref = a;
             }
@@ -114,16 +184,22 @@ impl DaeProblem for MultibodyDae {
 }
 
 impl MultibodyDae {
+    /// Inputs at time t: held values plus slope · (t − t_in).
+    fn inputs_at(&self, t: f64) -> Vec<f64> {
+        self.inputs.iter().zip(&self.slopes).map(|(v, s)| v + s * (t - self.t_in)).collect()
+    }
+
     /// Store the current value of every angle measure, so expressions stay on its branch.
     fn record_angles(&mut self, t: f64, q: &[f64], u: &[f64]) {
         if self.sys.angle_refs.is_empty() {
             return;
         }
         let rec = std::cell::RefCell::new(Vec::new());
+        let inputs = self.inputs_at(t);
         {
             let sys = &self.sys;
             let ids: Vec<usize> = (0..sys.nb()).collect();
-            let mut ctx = LocalCtx::new(sys, &ids, q, u, &[], t, &self.inputs);
+            let mut ctx = LocalCtx::new(sys, &ids, q, u, &[], t, &inputs);
             ctx.record = Some(&rec);
             for el in &sys.constraints {
                 let mut out = vec![0.0; el.neq];
@@ -178,7 +254,8 @@ impl Simulator {
         y[..lay.n].copy_from_slice(&q);
         y[lay.u()..lay.u() + lay.n].copy_from_slice(&u);
         y[lay.lam()..lay.lam() + lay.m].copy_from_slice(&lam);
-        let mut dae = MultibodyDae { sys, lay, inputs };
+        let slopes = vec![0.0; inputs.len()];
+        let mut dae = MultibodyDae { sys, lay, inputs, slopes, t_in: t0 };
         dae.accepted(t0, &mut y);
         let mut radau = Radau::new(&dae, t0, y, opts.tol);
         if let Some(h) = opts.max_step {
@@ -198,6 +275,9 @@ impl Simulator {
             return Err(EngineError::Numeric(format!("cannot integrate backwards from {} to {t_end}", self.radau.t)));
         }
         self.acc = None;
+        // Each call starts afresh from (t, y, h): a communication point is a restart
+        // point, so a saved state reproduces the run exactly.
+        self.radau.reset();
         self.radau.advance(&mut self.dae, t_end).map_err(EngineError::Numeric)
     }
 
@@ -221,7 +301,7 @@ impl Simulator {
             let (q, u) = (self.q().to_vec(), self.u().to_vec());
             let s = &self.dae;
             self.acc = Some(
-                init::accelerations(&s.sys, &q, &u, self.radau.t, &s.inputs, &mut self.acc_lu)
+                init::accelerations(&s.sys, &q, &u, self.radau.t, &s.inputs_at(self.radau.t), &mut self.acc_lu)
                     .map_err(EngineError::Numeric)?,
             );
         }
@@ -241,7 +321,8 @@ impl Simulator {
         let ctx_loads = |f: LoadFn, e: ElementRef| -> f64 {
             self.element_load(e, &lam).map_or(f64::NAN, |(fo, to)| pick(f, fo, to))
         };
-        let mut ctx = LocalCtx::new(sys, &ids, self.q(), self.u(), &udot, self.radau.t, &self.dae.inputs);
+        let inputs = self.dae.inputs_at(self.radau.t);
+        let mut ctx = LocalCtx::new(sys, &ids, self.q(), self.u(), &udot, self.radau.t, &inputs);
         ctx.loads = Some(&ctx_loads);
         Ok(sys.outputs.iter().zip(&sys.output_bases).map(|(e, &b)| ctx.eval_expr(e, b)).collect())
     }
@@ -253,7 +334,8 @@ impl Simulator {
         let sys = &self.dae.sys;
         let (q, u) = (self.q(), self.u());
         let ids: Vec<usize> = (0..sys.nb()).collect();
-        let ctx = LocalCtx::new(sys, &ids, q, u, &[], self.radau.t, &self.dae.inputs);
+        let inputs = self.dae.inputs_at(self.radau.t);
+        let ctx = LocalCtx::new(sys, &ids, q, u, &[], self.radau.t, &inputs);
         let fidx = match e {
             ElementRef::SpringDamper(k) => Some(k),
             ElementRef::Sforce(k) => Some(m.1 + k),
@@ -271,7 +353,8 @@ impl Simulator {
             _ => return None,
         };
         let el = sys.constraints.get(cidx)?;
-        let f = crate::mechanics::kernels::constraint_first(sys, el, q, self.radau.t, &self.dae.inputs);
+        let f =
+            crate::mechanics::kernels::constraint_first(sys, el, q, self.radau.t, &self.dae.inputs_at(self.radau.t));
         let nql = NQ * el.bodies.len();
         let mut genf = vec![0.0; nql];
         for e in 0..el.neq {
@@ -340,7 +423,13 @@ impl Simulator {
         s.constraints
             .iter()
             .flat_map(|el| {
-                crate::mechanics::kernels::constraint_values(s, el, self.q(), self.radau.t, &self.dae.inputs)
+                crate::mechanics::kernels::constraint_values(
+                    s,
+                    el,
+                    self.q(),
+                    self.radau.t,
+                    &self.dae.inputs_at(self.radau.t),
+                )
             })
             .fold(0.0, |a: f64, v| a.max(v.abs()))
     }
@@ -370,7 +459,8 @@ impl Simulator {
         for el in &s.forces {
             let ql = crate::mechanics::kernels::gather(&el.bodies, q);
             let ul = crate::mechanics::kernels::gather(&el.bodies, u);
-            let ctx = LocalCtx::new(s, &el.bodies, &ql, &ul, &[], self.radau.t, &self.dae.inputs);
+            let inputs = self.dae.inputs_at(self.radau.t);
+            let ctx = LocalCtx::new(s, &el.bodies, &ql, &ul, &[], self.radau.t, &inputs);
             e += el.potential(&ctx);
         }
         e
@@ -395,11 +485,80 @@ impl Simulator {
         v
     }
 
-    /// Set the value of input `i` (held constant until changed).
-    pub fn set_input(&mut self, i: usize, v: f64) {
-        self.dae.inputs[i] = v;
-        self.acc = None;
+    /// Everything that determines the future of the simulation (FMU state).
+    pub fn snapshot(&self) -> SimState {
+        SimState {
+            t: self.radau.t,
+            h: self.radau.h,
+            y: self.radau.y.clone(),
+            r0: self.dae.sys.r0.clone(),
+            angle_refs: self.dae.sys.angle_refs.clone(),
+            spring_refs: self.dae.sys.forces.iter().map(|f| f.angle_ref).collect(),
+            inputs: self.dae.inputs.clone(),
+            slopes: self.dae.slopes.clone(),
+            t_in: self.dae.t_in,
+        }
+    }
+
+    /// Return to a snapshot of this model's simulation.
+    pub fn restore(&mut self, s: &SimState) -> Result<(), EngineError> {
+        let d = &self.dae;
+        let fits = s.y.len() == self.radau.y.len()
+            && s.r0.len() == d.sys.r0.len()
+            && s.angle_refs.len() == d.sys.angle_refs.len()
+            && s.spring_refs.len() == d.sys.forces.len()
+            && s.inputs.len() == d.inputs.len()
+            && s.slopes.len() == d.slopes.len();
+        if !fits {
+            return Err(EngineError::Numeric("state does not belong to this model".into()));
+        }
+        self.radau.t = s.t;
+        self.radau.h = s.h;
+        self.radau.y.clone_from(&s.y);
+        self.dae.sys.r0.clone_from(&s.r0);
+        self.dae.sys.angle_refs.clone_from(&s.angle_refs);
+        for (f, &a) in self.dae.sys.forces.iter_mut().zip(&s.spring_refs) {
+            f.angle_ref = a;
+        }
+        self.dae.inputs.clone_from(&s.inputs);
+        self.dae.slopes.clone_from(&s.slopes);
+        self.dae.t_in = s.t_in;
         self.radau.reset();
+        self.acc = None;
+        Ok(())
+    }
+
+    /// Number of inputs.
+    pub fn n_inputs(&self) -> usize {
+        self.dae.inputs.len()
+    }
+
+    /// Current input values.
+    pub fn inputs(&self) -> Vec<f64> {
+        self.dae.inputs_at(self.radau.t)
+    }
+
+    /// Set input `i` from now on: held constant (slope 0) until changed.
+    pub fn set_input(&mut self, i: usize, v: f64) {
+        self.rebase_inputs();
+        self.dae.inputs[i] = v;
+        self.dae.slopes[i] = 0.0;
+        self.acc = None;
+    }
+
+    /// Set the time derivative of input `i`: from now on it changes linearly (FMI
+    /// `fmi2SetRealInputDerivatives`, order 1) until set again.
+    pub fn set_input_derivative(&mut self, i: usize, slope: f64) {
+        self.rebase_inputs();
+        self.dae.slopes[i] = slope;
+        self.acc = None;
+    }
+
+    /// Move the inputs' reference time to now (values unchanged).
+    fn rebase_inputs(&mut self) {
+        let t = self.radau.t;
+        self.dae.inputs = self.dae.inputs_at(t);
+        self.dae.t_in = t;
     }
 }
 
