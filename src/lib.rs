@@ -6,6 +6,7 @@
 pub mod ad;
 pub mod cli;
 pub mod dae;
+pub mod fmi;
 pub mod geom;
 pub mod mechanics;
 pub mod model;
