@@ -528,6 +528,12 @@ impl Simulator {
         Ok(())
     }
 
+    /// First time derivatives of the `<output>`s at the current time (FMI
+    /// `fmi2GetRealOutputDerivatives`, order 1).
+    pub fn output_derivatives(&mut self) -> Result<Vec<f64>, EngineError> {
+        Err(EngineError::Numeric("output derivatives are not available yet".into()))
+    }
+
     /// Number of inputs.
     pub fn n_inputs(&self) -> usize {
         self.dae.inputs.len()

@@ -2,4 +2,5 @@
 //! references, enforces the FMI state machine, logs, and calls the engine; it computes
 //! nothing itself.
 
+pub mod guid;
 pub mod variables;

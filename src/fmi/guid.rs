@@ -1,0 +1,53 @@
+//! Identity of an FMU: its GUID (a hash of the model text and the engine version, so a
+//! changed model or engine gives a new GUID) and its modelIdentifier (from the model name).
+
+/// Engine version: crate version and a fingerprint of the engine sources (build.rs).
+pub const ENGINE_VERSION: &str = concat!(env!("CARGO_PKG_VERSION"), "+", env!("MBFMU_ENGINE_FINGERPRINT"));
+
+/// 128-bit FNV-1a.
+fn fnv1a128(parts: &[&[u8]]) -> u128 {
+    let mut h: u128 = 0x6c62272e07bb014262b821756295c58d;
+    let prime: u128 = 0x0000000001000000000000000000013B;
+    for p in parts {
+        for b in *p {
+            h ^= *b as u128;
+            h = h.wrapping_mul(prime);
+        }
+        h ^= 0xff;
+        h = h.wrapping_mul(prime);
+    }
+    h
+}
+
+/// The GUID of the FMU of `model_text`: `{8-4-4-4-12}` hex digits.
+pub fn guid(model_text: &str) -> String {
+    let h = fnv1a128(&[ENGINE_VERSION.as_bytes(), model_text.as_bytes()]);
+    let s = format!("{h:032x}");
+    format!("{{{}-{}-{}-{}-{}}}", &s[0..8], &s[8..12], &s[12..16], &s[16..20], &s[20..32])
+}
+
+/// A C identifier from a model name (the format's names already are; anything else
+/// becomes `_`, and a leading digit gets a `_` prefix).
+pub fn model_identifier(name: &str) -> String {
+    let mut s: String = name.chars().map(|c| if c.is_ascii_alphanumeric() || c == '_' { c } else { '_' }).collect();
+    if s.is_empty() || s.starts_with(|c: char| c.is_ascii_digit()) {
+        s.insert(0, '_');
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn guid_changes_with_the_model_text_and_is_well_formed() {
+        let (a, b) = (guid("<multibody a/>"), guid("<multibody b/>"));
+        assert_ne!(a, b);
+        assert_eq!(a, guid("<multibody a/>"));
+        assert_eq!(a.len(), 38);
+        assert!(a.starts_with('{') && a.ends_with('}'));
+        assert_eq!(model_identifier("double pendulum-2"), "double_pendulum_2");
+        assert_eq!(model_identifier("2d"), "_2d");
+    }
+}
