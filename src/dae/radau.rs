@@ -124,6 +124,18 @@ impl Radau {
         self.faccon = 1.0;
     }
 
+    /// First and second time derivatives of y at the current time from the collocation
+    /// polynomial of the last accepted step (None right after a reset).
+    pub fn derivatives_at_end(&self) -> Option<(Vec<f64>, Vec<f64>)> {
+        let c = self.cont.as_ref()?;
+        let h = self.h_old;
+        let (a, b) = (self.tb.c[1] - 1.0, self.tb.c[0] - 1.0);
+        // y(s) = y + s(k1 + (s − a)(k2 + (s − b)k3)), s = (t − t_end)/h.
+        let d1 = (0..self.y.len()).map(|i| (c[0][i] - a * c[1][i] + a * b * c[2][i]) / h).collect();
+        let d2 = (0..self.y.len()).map(|i| 2.0 * (c[1][i] - (a + b) * c[2][i]) / (h * h)).collect();
+        Some((d1, d2))
+    }
+
     /// Integrate to exactly `t_end`.
     pub fn advance<P: DaeProblem>(&mut self, p: &mut P, t_end: f64) -> Result<(), String> {
         let hmin = 1e-14 * t_end.abs().max(1.0);

@@ -530,8 +530,36 @@ impl Simulator {
 
     /// First time derivatives of the `<output>`s at the current time (FMI
     /// `fmi2GetRealOutputDerivatives`, order 1).
+    ///
+    /// Exact (by dual numbers along the motion: q̇ = H u, u̇ from the equations of motion,
+    /// input slopes, time) for outputs of positions, velocities, time and inputs. Outputs of
+    /// accelerations also need the jerk, taken from the integrator's collocation polynomial
+    /// over the last step (zero right after a state was restored); loads count as constant.
     pub fn output_derivatives(&mut self) -> Result<Vec<f64>, EngineError> {
-        Err(EngineError::Numeric("output derivatives are not available yet".into()))
+        use crate::ad::Dual;
+        type D = Dual<f64, 1>;
+        let (udot, lam) = self.accelerations()?;
+        let n = self.dae.lay.n;
+        let jerk = self.radau.derivatives_at_end().map(|(_, d2)| d2[n..2 * n].to_vec());
+        let (q, u) = (self.q().to_vec(), self.u().to_vec());
+        let qd: Vec<f64> = (0..self.dae.sys.nb())
+            .flat_map(|b| crate::mechanics::body::qdot(&q[NQ * b..NQ * b + NQ], &u[NQ * b..NQ * b + NQ]))
+            .collect();
+        let mk = |v: &[f64], d: &[f64]| -> Vec<D> { v.iter().zip(d).map(|(&v, &d)| D { v, d: [d] }).collect() };
+        let qv = mk(&q, &qd);
+        let uv = mk(&u, &udot);
+        let av = mk(&udot, jerk.as_deref().unwrap_or(&vec![0.0; n]));
+        let t = self.radau.t;
+        let inputs = self.dae.inputs_at(t);
+        let sys = &self.dae.sys;
+        let ids: Vec<usize> = (0..sys.nb()).collect();
+        let ctx_loads = |f: LoadFn, e: ElementRef| -> f64 {
+            self.element_load(e, &lam).map_or(f64::NAN, |(fo, to)| pick(f, fo, to))
+        };
+        let mut ctx = LocalCtx::new(sys, &ids, &qv, &uv, &av, D { v: t, d: [1.0] }, &inputs);
+        ctx.input_values = Some(mk(&inputs, &self.dae.slopes));
+        ctx.loads = Some(&ctx_loads);
+        Ok(sys.outputs.iter().zip(&sys.output_bases).map(|(e, &b)| ctx.eval_expr(e, b).d[0]).collect())
     }
 
     /// Number of inputs.

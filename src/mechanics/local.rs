@@ -40,6 +40,8 @@ pub struct LocalCtx<'a, T: Real> {
     angle_base: Cell<usize>,
     /// When set, every unwrapped angle is recorded as (global slot, value).
     pub record: Option<&'a RefCell<Vec<(usize, f64)>>>,
+    /// When set, inputs read these (e.g. seeded dual numbers) instead of `inputs`.
+    pub input_values: Option<Vec<T>>,
 }
 
 impl<'a, T: Real> LocalCtx<'a, T> {
@@ -57,7 +59,17 @@ impl<'a, T: Real> LocalCtx<'a, T> {
                 LocalBody { r, a, v: get(u, 0), w: get(u, 3), acc: get(udot, 0), wdot: get(udot, 3) }
             })
             .collect();
-        LocalCtx { sys, ids, bodies, t, inputs, loads: None, angle_base: Cell::new(0), record: None }
+        LocalCtx {
+            sys,
+            ids,
+            bodies,
+            t,
+            inputs,
+            loads: None,
+            angle_base: Cell::new(0),
+            record: None,
+            input_values: None,
+        }
     }
 
     /// Evaluate expression `e` whose angle measures use global slots from `angle_base`.
@@ -90,7 +102,10 @@ impl<T: Real> ExprEnv<T> for LocalCtx<'_, T> {
         T::cst(self.sys.params[i])
     }
     fn input(&self, i: usize) -> T {
-        T::cst(self.inputs[i])
+        match &self.input_values {
+            Some(v) => v[i],
+            None => T::cst(self.inputs[i]),
+        }
     }
     fn variable(&self, _i: usize) -> T {
         T::cst(f64::NAN)
