@@ -8,5 +8,6 @@ pub mod cli;
 pub mod dae;
 pub mod fmi;
 pub mod geom;
+pub mod linearize;
 pub mod mechanics;
 pub mod model;

@@ -211,6 +211,9 @@ impl MultibodyDae {
             for (e, &b) in sys.outputs.iter().zip(&sys.output_bases) {
                 ctx.eval_expr(e, b);
             }
+            for (_, e, b) in &sys.lin_states {
+                ctx.eval_expr(e, *b);
+            }
         }
         for (g, v) in rec.into_inner() {
             self.sys.angle_refs[g] = v;
@@ -286,11 +289,18 @@ impl Simulator {
         self.radau.stats
     }
 
-    fn q(&self) -> &[f64] {
+    /// The mechanical system (with its current Euler-angle reference frames).
+    pub fn system(&self) -> &System {
+        &self.dae.sys
+    }
+
+    /// Current coordinates q.
+    pub fn q(&self) -> &[f64] {
         &self.radau.y[..self.dae.lay.n]
     }
 
-    fn u(&self) -> &[f64] {
+    /// Current velocities u.
+    pub fn u(&self) -> &[f64] {
         let l = self.dae.lay;
         &self.radau.y[l.u()..l.u() + l.n]
     }

@@ -121,6 +121,39 @@ impl SparseLu {
         self.solve_mat(b.as_mut())
     }
 
+    /// Solve A X = B in place for the columns of `b`, splitting them over `threads`
+    /// threads (each with its own scratch); the factorization is shared read-only.
+    pub fn solve_parallel(&self, b: MatMut<'_, f64>, threads: usize) -> bool {
+        let (Some(s), Some(numeric)) = (&self.symbolic, &self.numeric) else { return false };
+        let solve = |mut part: MatMut<'_, f64>| -> bool {
+            let mut buf = MemBuffer::new(s.lu.solve_in_place_scratch::<f64>(part.ncols(), Par::Seq));
+            LuRef::new_unchecked(&s.lu, numeric).solve_in_place_with_conj(
+                Conj::No,
+                part.as_mut(),
+                Par::Seq,
+                MemStack::new(&mut buf),
+            );
+            (0..part.ncols()).all(|j| (0..part.nrows()).all(|i| part[(i, j)].is_finite()))
+        };
+        let k = b.ncols();
+        let threads = threads.clamp(1, k.max(1));
+        if threads == 1 {
+            return solve(b);
+        }
+        let chunk = k.div_ceil(threads);
+        std::thread::scope(|sc| {
+            let mut rest = b;
+            let mut handles = Vec::new();
+            while rest.ncols() > 0 {
+                let take = chunk.min(rest.ncols());
+                let (head, tail) = rest.split_at_col_mut(take);
+                rest = tail;
+                handles.push(sc.spawn(move || solve(head)));
+            }
+            handles.into_iter().all(|h| h.join().unwrap_or(false))
+        })
+    }
+
     fn solve_mat(&mut self, mut b: MatMut<'_, f64>) -> bool {
         let (Some(s), Some(numeric)) = (&self.symbolic, &self.numeric) else { return false };
         let req = s.lu.solve_in_place_scratch::<f64>(b.ncols(), Par::Seq);

@@ -166,3 +166,21 @@ pub fn gyroscopic(j: &[[f64; 3]; 3], w: &[f64]) -> ([f64; 3], [f64; 9]) {
     let g = -wd.cross(&jw);
     (g.val(), std::array::from_fn(|i| g.0[i / 3].d[i % 3]))
 }
+
+/// ∂Q/∂v of one force element for every input v: `ni` columns of 6nb entries.
+pub fn force_input_jacobian(sys: &System, el: &ForceEl, q: &[f64], u: &[f64], t: f64, inputs: &[f64]) -> Vec<Vec<f64>> {
+    let (ql, ul) = (gather(&el.bodies, q), gather(&el.bodies, u));
+    let lift = |x: &[f64]| -> Vec<Dual<f64, 1>> { x.iter().map(|&v| Dual::cst(v)).collect() };
+    (0..inputs.len())
+        .map(|k| {
+            let (qd, ud) = (lift(&ql), lift(&ul));
+            let mut ctx = LocalCtx::new(sys, &el.bodies, &qd, &ud, &[], Dual::cst(t), inputs);
+            ctx.input_values = Some(
+                inputs.iter().enumerate().map(|(i, &v)| if i == k { Dual::var(v, 0) } else { Dual::cst(v) }).collect(),
+            );
+            let mut out = vec![Dual::zero(); NQ * el.bodies.len()];
+            el.generalized(&ctx, &mut out);
+            out.iter().map(|e| e.d[0]).collect()
+        })
+        .collect()
+}

@@ -49,9 +49,12 @@ pub struct System {
     pub ic_velocities: Vec<VelocityIc>,
     pub forces: Vec<ForceEl>,
     pub output_names: Vec<String>,
+    pub input_names: Vec<String>,
     pub outputs: Vec<Expr>,
     /// First angle-unwrapping slot of each output expression.
     pub output_bases: Vec<usize>,
+    /// User linearization states `<linearization><state>`: name, s(q, t), angle slot base.
+    pub lin_states: Vec<(String, Expr, usize)>,
     /// Value of every angle measure at the last accepted step (NaN: none yet); expressions
     /// keep their angles on the branch nearest these, so angles are continuous in time.
     pub angle_refs: Vec<f64>,
@@ -282,8 +285,14 @@ impl System {
             ic_velocities,
             forces,
             output_bases: model.outputs.iter().map(|o| alloc(&o.function)).collect(),
+            lin_states: model
+                .lin_states
+                .iter()
+                .map(|s| (s.name.clone(), s.function.clone(), alloc(&s.function)))
+                .collect(),
             angle_refs: vec![f64::NAN; slots],
             output_names: model.outputs.iter().map(|o| o.name.clone()).collect(),
+            input_names: model.inputs.iter().map(|i| i.name.clone()).collect(),
             outputs: model.outputs.iter().map(|o| o.function.clone()).collect(),
             q_init,
             u_init,

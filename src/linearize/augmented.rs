@@ -1,0 +1,258 @@
+//! The augmented sensitivity system (seed Eq. 34a–34k, Table 1): unknowns
+//! (u̇, q̇, Ẇ, Ṡ, λ, u, q, W, S) differentiated with respect to the virtual states (S̄, W̄)
+//! and the inputs v. One sparse matrix, one sparse LU, all right-hand sides at once
+//! (split over threads). Nothing is reduced to the state-space ODE (Eq. 6).
+
+use super::jets::{PositionFn, jets};
+use super::outputs::output_gradient;
+use super::select::Selection;
+use crate::dae::equations::{Layout, jacobian};
+use crate::dae::sparse::{SparseLu, Triplets};
+use crate::dae::{EngineError, Simulator};
+use crate::mechanics::body::NQ;
+use crate::mechanics::kernels::force_input_jacobian;
+use faer::Mat;
+
+/// A, B, C, D at one operating point, with the names of states, inputs and outputs.
+#[derive(Clone, Debug)]
+pub struct Linearization {
+    pub time: f64,
+    /// State names: S then W (`der(S)`).
+    pub states: Vec<String>,
+    pub inputs: Vec<String>,
+    pub outputs: Vec<String>,
+    /// Row-major matrices: A (2s × 2s), B (2s × ni), C (no × 2s), D (no × ni).
+    pub a: Mat<f64>,
+    pub b: Mat<f64>,
+    pub c: Mat<f64>,
+    pub d: Mat<f64>,
+    /// Values of the states S and W at the operating point.
+    pub x: Vec<f64>,
+}
+
+/// Column (unknown) and row (equation) offsets of Eq. 34.
+struct Blocks {
+    n: usize,
+    m: usize,
+    s: usize,
+}
+
+impl Blocks {
+    fn ud(&self) -> usize {
+        0
+    }
+    fn qd(&self) -> usize {
+        self.n
+    }
+    fn wd(&self) -> usize {
+        2 * self.n
+    }
+    fn sd(&self) -> usize {
+        2 * self.n + self.s
+    }
+    fn lam(&self) -> usize {
+        2 * self.n + 2 * self.s
+    }
+    fn u(&self) -> usize {
+        2 * self.n + 2 * self.s + self.m
+    }
+    fn q(&self) -> usize {
+        3 * self.n + 2 * self.s + self.m
+    }
+    fn w(&self) -> usize {
+        4 * self.n + 2 * self.s + self.m
+    }
+    fn sv(&self) -> usize {
+        4 * self.n + 3 * self.s + self.m
+    }
+    fn dim(&self) -> usize {
+        4 * self.n + 4 * self.s + self.m
+    }
+    // Rows: 34a n, 34b n, 34c m, 34d m, 34e m, 34f..34k s each.
+    fn row(&self, eq: char) -> usize {
+        let (n, m, s) = (self.n, self.m, self.s);
+        match eq {
+            'a' => 0,
+            'b' => n,
+            'c' => 2 * n,
+            'd' => 2 * n + m,
+            'e' => 2 * n + 2 * m,
+            'f' => 2 * n + 3 * m,
+            'g' => 2 * n + 3 * m + s,
+            'h' => 2 * n + 3 * m + 2 * s,
+            'i' => 2 * n + 3 * m + 3 * s,
+            'j' => 2 * n + 3 * m + 4 * s,
+            _ => 2 * n + 3 * m + 5 * s,
+        }
+    }
+}
+
+/// Linearize the simulation at its current point in the states of `sel` (Eq. 34, 36).
+pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result<Linearization, EngineError> {
+    let (udot, lam) = sim.accelerations()?;
+    let t = sim.time();
+    let inputs = sim.inputs();
+    let (q, u) = (sim.q().to_vec(), sim.u().to_vec());
+    let sys = sim.system();
+    let (n, m, s) = (sys.n(), sys.m, sel.states.len());
+    if sel.rank != m || s + m != n {
+        return Err(EngineError::Numeric(format!(
+            "linearization needs independent constraints: {m} equations, rank {} (redundant constraints)",
+            sel.rank
+        )));
+    }
+    let bl = Blocks { n, m, s };
+    let mut k = Triplets::new();
+    // Eq. 34a, 34b, 34d, 34e from the integrator's exact Jacobian of
+    // f = [Hu; Q − Pᵀλ; C; Ċ] at μ = 0.
+    let lay = Layout { n, m };
+    let mut y = vec![0.0; lay.dim()];
+    y[..n].copy_from_slice(&q);
+    y[n..2 * n].copy_from_slice(&u);
+    y[2 * n..2 * n + m].copy_from_slice(&lam);
+    let mut jac = Triplets::new();
+    jacobian(sys, lay, t, &y, &inputs, &mut jac);
+    for (p, &v) in jac.idx.iter().zip(&jac.vals) {
+        let (r, c) = (p.row, p.col);
+        let col = if c < n {
+            bl.q() + c
+        } else if c < 2 * n {
+            bl.u() + c - n
+        } else if c < 2 * n + m {
+            bl.lam() + c - 2 * n
+        } else {
+            continue; // μ does not appear in Eq. 34
+        };
+        if r < n {
+            k.push(bl.row('b') + r, col, -v); // 34b: q̇ − H(q)u
+        } else if r < 2 * n {
+            k.push(bl.row('a') + r - n, col, -v); // 34a: M u̇ − (Q − Pᵀλ)
+        } else if r < 2 * n + m {
+            k.push(bl.row('e') + r - 2 * n, col, v); // 34e: C
+        } else {
+            k.push(bl.row('d') + r - 2 * n - m, col, v); // 34d: Ċ
+        }
+    }
+    for i in 0..n {
+        k.push(bl.row('b') + i, bl.qd() + i, 1.0);
+    }
+    for (b, body) in sys.bodies.iter().enumerate() {
+        let o = NQ * b;
+        for c in 0..3 {
+            k.push(bl.row('a') + o + c, bl.ud() + o + c, body.mass);
+        }
+        for r in 0..3 {
+            for c in 0..3 {
+                k.push(bl.row('a') + o + 3 + r, bl.ud() + o + 3 + c, body.inertia[r][c]);
+            }
+        }
+    }
+    // Eq. 34c: C̈(u̇, u, q, t) = 0, exact gradients from the time jets.
+    let push_z = |k: &mut Triplets, row: usize, bodies: &[usize], dz: &[f64], sign: f64, with_acc: bool| {
+        let nql = NQ * bodies.len();
+        for a in 0..nql {
+            let g = NQ * bodies[a / NQ] + a % NQ;
+            k.push(row, bl.q() + g, sign * dz[a]);
+            k.push(row, bl.u() + g, sign * dz[nql + a]);
+            if with_acc {
+                k.push(row, bl.ud() + g, sign * dz[2 * nql + a]);
+            }
+        }
+    };
+    for el in &sys.constraints {
+        for (e, jet) in jets(sys, el, &q, &u, &udot, t, &inputs).iter().enumerate() {
+            push_z(&mut k, bl.row('c') + el.row + e, el.bodies(), &jet.dg2, 1.0, true);
+        }
+    }
+    // Eq. 34f–34k for each selected state.
+    let mut x = vec![0.0; 2 * s];
+    for (i, st) in sel.states.iter().enumerate() {
+        let jet = &jets(sys, st, &q, &u, &udot, t, &inputs)[0];
+        x[i] = jet.g;
+        x[s + i] = jet.g1;
+        k.push(bl.row('f') + i, bl.sv() + i, 1.0);
+        push_z(&mut k, bl.row('f') + i, st.bodies(), &jet.dg, -1.0, false);
+        k.push(bl.row('g') + i, bl.sd() + i, 1.0);
+        k.push(bl.row('g') + i, bl.w() + i, -1.0);
+        k.push(bl.row('h') + i, bl.w() + i, 1.0);
+        push_z(&mut k, bl.row('h') + i, st.bodies(), &jet.dg1, -1.0, false);
+        k.push(bl.row('i') + i, bl.wd() + i, 1.0);
+        push_z(&mut k, bl.row('i') + i, st.bodies(), &jet.dg2, -1.0, true);
+        k.push(bl.row('j') + i, bl.w() + i, 1.0);
+        k.push(bl.row('k') + i, bl.sv() + i, 1.0);
+    }
+    // Right-hand sides: ∂/∂S̄ (34k), ∂/∂W̄ (34j), ∂/∂v (34a: +∂Q/∂v).
+    let ni = inputs.len();
+    let dim = bl.dim();
+    let mut rhs = Mat::<f64>::zeros(dim, 2 * s + ni);
+    for i in 0..s {
+        rhs[(bl.row('k') + i, i)] = 1.0;
+        rhs[(bl.row('j') + i, s + i)] = 1.0;
+    }
+    for el in &sys.forces {
+        for (v, col) in force_input_jacobian(sys, el, &q, &u, t, &inputs).iter().enumerate() {
+            for (a, &val) in col.iter().enumerate() {
+                rhs[(bl.row('a') + NQ * el.bodies[a / NQ] + a % NQ, 2 * s + v)] += val;
+            }
+        }
+    }
+    let mut lu = SparseLu::new();
+    let singular = || {
+        EngineError::Numeric(format!(
+            "at t = {t}: the linearization states ({}) no longer parameterize the motion (singular partition); \
+             choose user states (<linearization>) that stay independent",
+            sel.states.iter().map(|s| s.name.as_str()).collect::<Vec<_>>().join(", ")
+        ))
+    };
+    lu.factor(dim, &k).map_err(|_| singular())?;
+    if !lu.solve_parallel(rhs.as_mut(), threads) {
+        return Err(singular());
+    }
+    // A and B: rows Ṡ, Ẇ of the solution.
+    let pick = |r: usize, c: usize| if r < s { rhs[(bl.sd() + r, c)] } else { rhs[(bl.wd() + r - s, c)] };
+    let a = Mat::from_fn(2 * s, 2 * s, pick);
+    let b = Mat::from_fn(2 * s, ni, |r, c| pick(r, 2 * s + c));
+    // C and D: chain rule through q, u, u̇ sensitivities.
+    let no = sys.outputs.len();
+    let mut c = Mat::<f64>::zeros(no, 2 * s);
+    let mut d = Mat::<f64>::zeros(no, ni);
+    for (o, (e, &abase)) in sys.outputs.iter().zip(&sys.output_bases).enumerate() {
+        let g = output_gradient(sys, e, abase, &q, &u, &udot, t, &inputs);
+        let nql = NQ * g.bodies.len();
+        let sens = |col: usize| -> f64 {
+            let mut v = 0.0;
+            for a in 0..nql {
+                let gi = NQ * g.bodies[a / NQ] + a % NQ;
+                v += g.dz[a] * rhs[(bl.q() + gi, col)]
+                    + g.dz[nql + a] * rhs[(bl.u() + gi, col)]
+                    + g.dz[2 * nql + a] * rhs[(bl.ud() + gi, col)];
+            }
+            v
+        };
+        for col in 0..2 * s {
+            c[(o, col)] = sens(col);
+        }
+        for v in 0..ni {
+            d[(o, v)] = sens(2 * s + v) + g.dv[v];
+        }
+        if (0..2 * s).any(|col| !c[(o, col)].is_finite()) || (0..ni).any(|v| !d[(o, v)].is_finite()) {
+            return Err(EngineError::Numeric(format!(
+                "output '{}' cannot be linearized (element loads are not differentiated yet)",
+                sys.output_names[o]
+            )));
+        }
+    }
+    let mut states: Vec<String> = sel.states.iter().map(|s| s.name.clone()).collect();
+    states.extend(sel.states.iter().map(|s| format!("der({})", s.name)));
+    Ok(Linearization {
+        time: t,
+        states,
+        inputs: sys.input_names.clone(),
+        outputs: sys.output_names.clone(),
+        a,
+        b,
+        c,
+        d,
+        x,
+    })
+}

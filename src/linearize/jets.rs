@@ -1,0 +1,120 @@
+//! Position-level functions g(q, t) (constraints, linearization states) with their first
+//! and second time derivatives along the motion, ġ(q, u, t) and g̈(q, u, u̇, t), and the
+//! exact gradients of all three with respect to the local q, u, u̇ — the rows of Eq. 34c–e
+//! and 34f, h, i.
+//!
+//! One evaluation does it: the coordinates are time jets q + τ q̇ + τ²/2 q̈ written as
+//! nested dual numbers (q̇ = H u, q̈ = d(Hu)/dt), whose base scalar is itself a dual
+//! number seeded on (q, u, u̇, t).
+
+use crate::ad::{Dual, Real};
+use crate::mechanics::System;
+use crate::mechanics::body::{NQ, qdot};
+use crate::mechanics::constraints::ConstraintEl;
+use crate::mechanics::kernels::gather;
+use crate::mechanics::local::LocalCtx;
+
+/// A function of body poses and time, evaluated generically.
+pub trait PositionFn {
+    /// Bodies it depends on (global indices).
+    fn bodies(&self) -> &[usize];
+    /// Number of components.
+    fn components(&self) -> usize;
+    /// Evaluate into `out`.
+    fn eval<T: Real>(&self, ctx: &LocalCtx<T>, out: &mut [T]);
+}
+
+impl PositionFn for ConstraintEl {
+    fn bodies(&self) -> &[usize] {
+        &self.bodies
+    }
+    fn components(&self) -> usize {
+        self.neq
+    }
+    fn eval<T: Real>(&self, ctx: &LocalCtx<T>, out: &mut [T]) {
+        self.kind.eval(ctx, out)
+    }
+}
+
+/// g, ġ, g̈ of one component with gradients over z = (local q, local u, local u̇, t).
+#[derive(Clone, Debug)]
+pub struct Jet {
+    pub g: f64,
+    pub g1: f64,
+    pub g2: f64,
+    /// Gradients (length 18·nb + 1).
+    pub dg: Vec<f64>,
+    pub dg1: Vec<f64>,
+    pub dg2: Vec<f64>,
+}
+
+/// Jets of every component of `f` at (q, u, u̇, t) (global vectors).
+pub fn jets<F: PositionFn>(
+    sys: &System,
+    f: &F,
+    q: &[f64],
+    u: &[f64],
+    udot: &[f64],
+    t: f64,
+    inputs: &[f64],
+) -> Vec<Jet> {
+    match f.bodies().len() {
+        0 => jets_k::<1, F>(sys, f, q, u, udot, t, inputs),
+        1 => jets_k::<19, F>(sys, f, q, u, udot, t, inputs),
+        2 => jets_k::<37, F>(sys, f, q, u, udot, t, inputs),
+        3 => jets_k::<55, F>(sys, f, q, u, udot, t, inputs),
+        _ => jets_k::<73, F>(sys, f, q, u, udot, t, inputs),
+    }
+}
+
+fn jets_k<const K: usize, F: PositionFn>(
+    sys: &System,
+    f: &F,
+    q: &[f64],
+    u: &[f64],
+    udot: &[f64],
+    t: f64,
+    inputs: &[f64],
+) -> Vec<Jet> {
+    type B<const K: usize> = Dual<f64, K>;
+    let bodies = f.bodies();
+    let nq = NQ * bodies.len();
+    let seed =
+        |x: Vec<f64>, off: usize| -> Vec<B<K>> { x.iter().enumerate().map(|(i, &v)| B::var(v, off + i)).collect() };
+    let qb = seed(gather(bodies, q), 0);
+    let ub = seed(gather(bodies, u), nq);
+    let ab = seed(gather(bodies, udot), 2 * nq);
+    let tb = B::<K>::var(t, 3 * nq);
+    let mut qj = Vec::with_capacity(nq);
+    for k in 0..bodies.len() {
+        let r = NQ * k..NQ * k + NQ;
+        let qd = qdot(&qb[r.clone()], &ub[r.clone()]);
+        // q̈ = d/dt (H(q) u) = directional derivative along (q̇, u̇).
+        let qe: Vec<Dual<B<K>, 1>> = qb[r.clone()].iter().zip(&qd).map(|(&v, &d)| Dual { v, d: [d] }).collect();
+        let ue: Vec<Dual<B<K>, 1>> = ub[r.clone()].iter().zip(&ab[r]).map(|(&v, &d)| Dual { v, d: [d] }).collect();
+        let qdd = qdot(&qe, &ue);
+        for i in 0..NQ {
+            qj.push(jet(qb[NQ * k + i], qd[i], qdd[i].d[0]));
+        }
+    }
+    let tj = jet(tb, B::one(), B::zero());
+    let ctx = LocalCtx::new(sys, bodies, &qj, &[], &[], tj, inputs);
+    let mut out = vec![Dual::zero(); f.components()];
+    f.eval(&ctx, &mut out);
+    let kk = 3 * nq + 1;
+    out.iter()
+        .map(|o| Jet {
+            g: o.v.v.v,
+            g1: o.v.d[0].v,
+            g2: o.d[0].d[0].v,
+            dg: o.v.v.d[..kk].to_vec(),
+            dg1: o.v.d[0].d[..kk].to_vec(),
+            dg2: o.d[0].d[0].d[..kk].to_vec(),
+        })
+        .collect()
+}
+
+/// x(τ) = x0 + τ x1 + τ²/2 x2 as nested duals: first and second τ-derivatives exact.
+fn jet<T: Real>(x0: T, x1: T, x2: T) -> Dual<Dual<T, 1>, 1> {
+    Dual { v: Dual { v: x0, d: [x1] }, d: [Dual { v: x1, d: [x2] }] }
+}

@@ -1,0 +1,67 @@
+//! Linearization states S = s(q, t) (seed Eq. 30, 34f): user expressions, and the internal
+//! candidates — each body's CM coordinates and its 3-1-3 angles relative to a reference
+//! frame fixed at selection time (so the names mean the same at every later point).
+
+use super::jets::PositionFn;
+use crate::ad::Real;
+use crate::geom::{M3, euler313_from_matrix};
+use crate::mechanics::System;
+use crate::mechanics::local::LocalCtx;
+use crate::model::expr::{Expr, deps};
+
+/// What a state measures.
+#[derive(Clone, Debug, PartialEq)]
+pub enum StateKind {
+    /// A `<linearization><state>` expression with its angle-unwrapping slot base.
+    User { f: Expr, abase: usize },
+    /// CM coordinate k (x, y, z) of a body, ground frame.
+    Position { k: usize },
+    /// 3-1-3 angle k (ψ, θ, φ) of a body relative to the fixed frame `r0`.
+    Angle { k: usize, r0: [[f64; 3]; 3] },
+}
+
+/// One linearization state.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StateFn {
+    pub name: String,
+    pub kind: StateKind,
+    pub bodies: Vec<usize>,
+}
+
+impl PositionFn for StateFn {
+    fn bodies(&self) -> &[usize] {
+        &self.bodies
+    }
+    fn components(&self) -> usize {
+        1
+    }
+    fn eval<T: Real>(&self, ctx: &LocalCtx<T>, out: &mut [T]) {
+        out[0] = match &self.kind {
+            StateKind::User { f, abase } => ctx.eval_expr(f, *abase),
+            StateKind::Position { k } => ctx.bodies[0].r.0[*k],
+            StateKind::Angle { k, r0 } => euler313_from_matrix(&M3::cst(r0).t().mm(&ctx.bodies[0].a))[*k],
+        };
+    }
+}
+
+/// The user's states of the model.
+pub fn user_states(sys: &System) -> Vec<StateFn> {
+    sys.lin_states
+        .iter()
+        .map(|(name, f, abase)| {
+            let mut bodies: Vec<usize> = deps(f).markers.iter().filter_map(|&m| sys.markers[m].body).collect();
+            bodies.sort_unstable();
+            bodies.dedup();
+            StateFn { name: name.clone(), kind: StateKind::User { f: f.clone(), abase: *abase }, bodies }
+        })
+        .collect()
+}
+
+/// The internal candidate for coordinate q[i]: `body.x|y|z|psi|theta|phi`, angles relative
+/// to the body's current reference frame.
+pub fn internal_state(sys: &System, i: usize) -> StateFn {
+    let (b, k) = (i / 6, i % 6);
+    let names = ["x", "y", "z", "psi", "theta", "phi"];
+    let kind = if k < 3 { StateKind::Position { k } } else { StateKind::Angle { k: k - 3, r0: sys.r0[b] } };
+    StateFn { name: format!("{}.{}", sys.bodies[b].name, names[k]), kind, bodies: vec![b] }
+}
