@@ -136,6 +136,45 @@ impl Radau {
         Some((d1, d2))
     }
 
+    /// Forget the Jacobian and its factorization (recomputed from y at the next step) but
+    /// keep the step history. After a restart the future depends only on (t, y, h) and
+    /// [`Radau::memory`], which makes a restored state reproduce a run bit for bit.
+    pub fn restart(&mut self) {
+        self.need_jac = true;
+        self.jac_fresh = false;
+        self.h_fact = f64::NAN;
+        self.f0_valid = false;
+    }
+
+    /// The step history that, with (t, y, h), determines the future after a restart:
+    /// [h_old, faccon, first, last_rejected, has_polynomial, polynomial (3·dim)].
+    pub fn memory(&self) -> Vec<f64> {
+        let flag = |b: bool| if b { 1.0 } else { 0.0 };
+        let mut v =
+            vec![self.h_old, self.faccon, flag(self.first), flag(self.last_rejected), flag(self.cont.is_some())];
+        if let Some(c) = &self.cont {
+            for k in c {
+                v.extend_from_slice(k);
+            }
+        }
+        v
+    }
+
+    /// Restore what [`Radau::memory`] returned (then restarts); false if it does not fit.
+    pub fn set_memory(&mut self, v: &[f64]) -> bool {
+        let n = self.y.len();
+        if v.len() < 5 || (v[4] != 0.0 && v.len() != 5 + 3 * n) || (v[4] == 0.0 && v.len() != 5) {
+            return false;
+        }
+        self.h_old = v[0];
+        self.faccon = v[1];
+        self.first = v[2] != 0.0;
+        self.last_rejected = v[3] != 0.0;
+        self.cont = (v[4] != 0.0).then(|| std::array::from_fn(|k| v[5 + k * n..5 + (k + 1) * n].to_vec()));
+        self.restart();
+        true
+    }
+
     /// Integrate to exactly `t_end`.
     pub fn advance<P: DaeProblem>(&mut self, p: &mut P, t_end: f64) -> Result<(), String> {
         let hmin = 1e-14 * t_end.abs().max(1.0);

@@ -75,6 +75,8 @@ pub struct SimState {
     pub inputs: Vec<f64>,
     pub slopes: Vec<f64>,
     pub t_in: f64,
+    /// The integrator's step history ([`crate::dae::radau::Radau::memory`]).
+    pub integrator: Vec<f64>,
 }
 
 const STATE_MAGIC: &[u8; 8] = b"MBFMUS01";
@@ -96,6 +98,7 @@ impl SimState {
         arr(&self.spring_refs);
         arr(&self.inputs);
         arr(&self.slopes);
+        arr(&self.integrator);
         b
     }
 
@@ -116,12 +119,23 @@ impl SimState {
         let head = arr()?;
         let y = arr()?;
         let r0f = arr()?;
-        let (angle_refs, spring_refs, inputs, slopes) = (arr()?, arr()?, arr()?, arr()?);
+        let (angle_refs, spring_refs, inputs, slopes, integrator) = (arr()?, arr()?, arr()?, arr()?, arr()?);
         if head.len() != 3 || r0f.len() % 9 != 0 || pos != rest.len() {
             return Err(bad());
         }
         let r0 = r0f.chunks_exact(9).map(|c| [[c[0], c[1], c[2]], [c[3], c[4], c[5]], [c[6], c[7], c[8]]]).collect();
-        Ok(SimState { t: head[0], h: head[1], t_in: head[2], y, r0, angle_refs, spring_refs, inputs, slopes })
+        Ok(SimState {
+            t: head[0],
+            h: head[1],
+            t_in: head[2],
+            y,
+            r0,
+            angle_refs,
+            spring_refs,
+            inputs,
+            slopes,
+            integrator,
+        })
     }
 }
 
@@ -278,9 +292,9 @@ impl Simulator {
             return Err(EngineError::Numeric(format!("cannot integrate backwards from {} to {t_end}", self.radau.t)));
         }
         self.acc = None;
-        // Each call starts afresh from (t, y, h): a communication point is a restart
-        // point, so a saved state reproduces the run exactly.
-        self.radau.reset();
+        // Each call recomputes the Jacobian from (t, y): a communication point is a restart
+        // point, so a saved state (with the step history) reproduces the run exactly.
+        self.radau.restart();
         self.radau.advance(&mut self.dae, t_end).map_err(EngineError::Numeric)
     }
 
@@ -507,6 +521,7 @@ impl Simulator {
             inputs: self.dae.inputs.clone(),
             slopes: self.dae.slopes.clone(),
             t_in: self.dae.t_in,
+            integrator: self.radau.memory(),
         }
     }
 
@@ -533,7 +548,9 @@ impl Simulator {
         self.dae.inputs.clone_from(&s.inputs);
         self.dae.slopes.clone_from(&s.slopes);
         self.dae.t_in = s.t_in;
-        self.radau.reset();
+        if !self.radau.set_memory(&s.integrator) {
+            self.radau.reset();
+        }
         self.acc = None;
         Ok(())
     }
