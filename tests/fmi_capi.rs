@@ -387,3 +387,24 @@ fn a_thousand_instantiate_free_cycles_and_parallel_instances_are_independent() {
         assert_eq!(r.join().unwrap(), want);
     }
 }
+
+#[test]
+fn a_panic_inside_an_export_becomes_fatal_when_the_engine_may_be_corrupt_and_error_otherwise() {
+    use mbfmu::fmi::guard::guarded;
+    use mbfmu::fmi::state_machine::Func;
+    let text = model_text("pendulum.xml");
+    let c = initialized(&text, 1e-6, &[]);
+    assert_eq!(guarded(c, Func::GetReal, |_| panic!("boom")), Status::Error);
+    assert_eq!(last_msg(c), "fmi2GetReal: internal error (panic): boom");
+    // SAFETY: a live instance.
+    assert_eq!(unsafe { instance_state(c) }, Some(State::Error));
+    // SAFETY: a live instance.
+    assert_eq!(unsafe { fmi2DoStep(c, 0.0, 0.1, 1) }, Status::Error, "no stepping in state Error");
+    let d = initialized(&text, 1e-6, &[]);
+    assert_eq!(guarded(d, Func::DoStep, |_| panic!("boom {}", 2)), Status::Fatal);
+    assert_eq!(last_msg(d), "fmi2DoStep: internal error (panic): boom 2");
+    // SAFETY: a live instance.
+    assert_eq!(unsafe { instance_state(d) }, Some(State::Fatal));
+    free(c);
+    free(d);
+}
