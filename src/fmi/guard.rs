@@ -9,7 +9,8 @@ use std::ffi::{CStr, c_char};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
 /// Run `body` on the instance `c` if `func` is legal in its state. `Err(msg)` becomes
-/// fmi2Error with "fmi2X: msg" logged; a panic becomes fmi2Error and state Error, or
+/// fmi2Error with "fmi2X: msg" logged (category logStatusError); a state change is logged
+/// under logEvents; a panic becomes fmi2Error and state Error, or
 /// fmi2Fatal and state Fatal when the function may have left the engine half-updated.
 /// A NULL `c` gives fmi2Error (there is no logger to tell).
 pub fn guarded(c: Component, func: Func, body: impl FnOnce(&mut Instance) -> Result<Status, String>) -> Status {
@@ -26,10 +27,15 @@ pub fn guarded(c: Component, func: Func, body: impl FnOnce(&mut Instance) -> Res
             inst.log(Status::Error, &msg);
             return Status::Error;
         }
-        body(inst).unwrap_or_else(|msg| {
+        let before = inst.state;
+        let status = body(inst).unwrap_or_else(|msg| {
             inst.log(Status::Error, &format!("{}: {msg}", func.name()));
             Status::Error
-        })
+        });
+        if inst.state != before {
+            inst.log(Status::Ok, &format!("{}: state {before:?} -> {:?}", func.name(), inst.state));
+        }
+        status
     }));
     run.unwrap_or_else(|payload| {
         let what = payload
