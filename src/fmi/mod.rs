@@ -2,5 +2,16 @@
 //! references, enforces the FMI state machine, logs, and calls the engine; it computes
 //! nothing itself.
 
+pub mod exports_common;
+pub mod exports_cs;
+pub mod exports_me;
+pub mod exports_state;
+pub mod fmu_state;
+pub mod guard;
 pub mod guid;
+pub mod instance;
+pub mod logger;
+pub mod state_machine;
+pub mod types;
+pub mod uri;
 pub mod variables;

@@ -1,0 +1,273 @@
+//! FMI 2.0 common functions (2.1 FMI Application Programming Interface): inquiry,
+//! instance lifecycle, initialization, and getting/setting values.
+//!
+//! Safety of every export: the host calls it as FMI 2.0 specifies (valid pointers with
+//! the stated lengths, a component from fmi2Instantiate not yet freed, one thread per
+//! instance at a time); NULL pointers are checked and refused, never dereferenced.
+#![allow(clippy::missing_safety_doc)]
+#![allow(non_snake_case)]
+
+use super::guard::{guarded, slice, slice_mut, text};
+use super::guid::guid;
+use super::instance::Instance;
+use super::logger::Logger;
+use super::state_machine::{Func, State};
+use super::types::{
+    Boolean, CO_SIMULATION, CallbackFunctions, Component, FmiString, Integer, MODEL_EXCHANGE, Real, Status, TRUE,
+    ValueReference,
+};
+use super::uri::file_uri_to_path;
+use libc::{c_char, c_int, size_t};
+use std::panic::{AssertUnwindSafe, catch_unwind};
+
+/// fmi2GetTypesPlatform: "default" (2.1.4 Inquire Platform and Version Number).
+#[unsafe(no_mangle)]
+pub extern "C" fn fmi2GetTypesPlatform() -> *const c_char {
+    c"default".as_ptr()
+}
+
+/// fmi2GetVersion: "2.0".
+#[unsafe(no_mangle)]
+pub extern "C" fn fmi2GetVersion() -> *const c_char {
+    c"2.0".as_ptr()
+}
+
+/// fmi2SetDebugLogging (2.1.5): logging on/off and the categories (none: all).
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2SetDebugLogging(
+    c: Component,
+    loggingOn: Boolean,
+    nCategories: size_t,
+    categories: *const FmiString,
+) -> Status {
+    guarded(c, Func::SetDebugLogging, |inst| {
+        // SAFETY: nCategories strings per the FMI contract.
+        let cats = unsafe { slice(categories, nCategories, "categories") }?;
+        // SAFETY: each entry is a NUL-terminated string per the FMI contract.
+        let names = cats.iter().map(|&p| unsafe { text(p, "a category") }).collect::<Result<Vec<_>, _>>()?;
+        inst.log.configure(loggingOn == TRUE, &names)?;
+        Ok(Status::Ok)
+    })
+}
+
+/// fmi2Instantiate (2.1.5): a Co-Simulation instance of the model in
+/// `<fmuResourceLocation>/model.xml`, or NULL (with the reason logged).
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2Instantiate(
+    instanceName: FmiString,
+    fmuType: c_int,
+    fmuGUID: FmiString,
+    fmuResourceLocation: FmiString,
+    functions: *const CallbackFunctions,
+    _visible: Boolean,
+    loggingOn: Boolean,
+) -> Component {
+    let made = catch_unwind(AssertUnwindSafe(|| {
+        if functions.is_null() {
+            return std::ptr::null_mut();
+        }
+        // SAFETY: non-NULL and pointing to the host's callback struct per FMI.
+        let callbacks = unsafe { *functions };
+        // SAFETY: a NUL-terminated string or NULL per FMI.
+        let name = unsafe { text(instanceName, "instanceName") };
+        let mut log = Logger::new(&callbacks, name.as_deref().unwrap_or("?"), loggingOn == TRUE);
+        // SAFETY: NUL-terminated strings or NULL per FMI.
+        let made = name.and_then(|name| unsafe { instantiate(&name, fmuType, fmuGUID, fmuResourceLocation) });
+        match made {
+            Ok((model, guid)) => Box::into_raw(Box::new(Instance::new(model, guid, log))).cast(),
+            Err(msg) => {
+                log.log(Status::Error, &format!("fmi2Instantiate: {msg}"));
+                std::ptr::null_mut()
+            }
+        }
+    }));
+    made.unwrap_or(std::ptr::null_mut())
+}
+
+/// Check the arguments and read the model.
+///
+/// # Safety
+/// `guid_p` and `res_p` are NULL or NUL-terminated.
+unsafe fn instantiate(
+    name: &str,
+    fmu_type: c_int,
+    guid_p: FmiString,
+    res_p: FmiString,
+) -> Result<(crate::model::Model, String), String> {
+    let fail = |m: String| format!("instance '{name}': {m}");
+    match fmu_type {
+        CO_SIMULATION => {}
+        MODEL_EXCHANGE => return Err(fail("Model Exchange is not supported (Co-Simulation only)".into())),
+        t => return Err(fail(format!("unknown fmuType {t}"))),
+    }
+    // SAFETY: per this function's contract.
+    let given = unsafe { text(guid_p, "fmuGUID") }.map_err(fail)?;
+    // SAFETY: per this function's contract.
+    let res = unsafe { text(res_p, "fmuResourceLocation") }.map_err(fail)?;
+    let file = file_uri_to_path(&res).map_err(fail)?.join("model.xml");
+    let model_text =
+        std::fs::read_to_string(&file).map_err(|e| fail(format!("cannot read {}: {e}", file.display())))?;
+    let own = guid(&model_text);
+    if given != own {
+        return Err(fail(format!("fmuGUID {given} does not match this FMU's {own} (model {})", file.display())));
+    }
+    let model = crate::model::parse::load_str(&model_text, &file.display().to_string())
+        .map_err(|e| fail(format!("invalid model: {e}")))?;
+    Ok((model, own))
+}
+
+/// fmi2FreeInstance (2.1.5): release the instance (NULL: nothing).
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2FreeInstance(c: Component) {
+    if c.is_null() {
+        return;
+    }
+    let _ = catch_unwind(AssertUnwindSafe(|| {
+        // SAFETY: `c` came from Box::into_raw in fmi2Instantiate and is freed once (FMI).
+        drop(unsafe { Box::from_raw(c.cast::<Instance>()) });
+    }));
+}
+
+/// fmi2SetupExperiment (2.1.6): tolerance, start and stop time.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2SetupExperiment(
+    c: Component,
+    toleranceDefined: Boolean,
+    tolerance: Real,
+    startTime: Real,
+    stopTimeDefined: Boolean,
+    stopTime: Real,
+) -> Status {
+    guarded(c, Func::SetupExperiment, |inst| {
+        let tol = (toleranceDefined == TRUE).then_some(tolerance);
+        inst.setup(tol, startTime, (stopTimeDefined == TRUE).then_some(stopTime))?;
+        Ok(Status::Ok)
+    })
+}
+
+/// fmi2EnterInitializationMode (2.1.6).
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2EnterInitializationMode(c: Component) -> Status {
+    guarded(c, Func::EnterInitializationMode, |inst| {
+        inst.state = State::InitializationMode;
+        Ok(Status::Ok)
+    })
+}
+
+/// fmi2ExitInitializationMode (2.1.6): the engine is built with the values set.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2ExitInitializationMode(c: Component) -> Status {
+    guarded(c, Func::ExitInitializationMode, |inst| {
+        inst.exit_initialization()?;
+        Ok(Status::Ok)
+    })
+}
+
+/// fmi2Terminate (2.1.6).
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2Terminate(c: Component) -> Status {
+    guarded(c, Func::Terminate, |inst| {
+        inst.state = State::Terminated;
+        Ok(Status::Ok)
+    })
+}
+
+/// fmi2Reset (2.1.6): back to the state after fmi2Instantiate.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2Reset(c: Component) -> Status {
+    guarded(c, Func::Reset, |inst| {
+        inst.reset();
+        Ok(Status::Ok)
+    })
+}
+
+/// fmi2GetReal (2.1.7 Getting and Setting Variable Values).
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2GetReal(c: Component, vr: *const ValueReference, nvr: size_t, value: *mut Real) -> Status {
+    guarded(c, Func::GetReal, |inst| {
+        // SAFETY: nvr elements each, per FMI.
+        let (vr, value) = unsafe { (slice(vr, nvr, "vr")?, slice_mut(value, nvr, "value")?) };
+        inst.get_reals(vr, value)?;
+        Ok(Status::Ok)
+    })
+}
+
+/// fmi2SetReal (2.1.7): parameters before initialization ends, inputs, never outputs.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2SetReal(
+    c: Component,
+    vr: *const ValueReference,
+    nvr: size_t,
+    value: *const Real,
+) -> Status {
+    guarded(c, Func::SetReal, |inst| {
+        // SAFETY: nvr elements each, per FMI.
+        let (vr, value) = unsafe { (slice(vr, nvr, "vr")?, slice(value, nvr, "value")?) };
+        inst.set_reals(vr, value)?;
+        Ok(Status::Ok)
+    })
+}
+
+/// The model has only Real variables: any value reference of another type is unknown.
+fn no_such(func: Func, vr: &[ValueReference]) -> Result<Status, String> {
+    match vr.first() {
+        None => Ok(Status::Ok),
+        Some(v) => Err(format!("unknown value reference {v} (the FMU has only Real variables; {})", func.name())),
+    }
+}
+
+/// Generate the getters and setters of the types the FMU has no variables of.
+macro_rules! no_variables {
+    ($($(#[$doc:meta])* $name:ident, $func:expr, $ptr:ty;)*) => {$(
+        $(#[$doc])*
+        #[unsafe(no_mangle)]
+        pub unsafe extern "C" fn $name(c: Component, vr: *const ValueReference, nvr: size_t, value: $ptr) -> Status {
+            guarded(c, $func, |_| {
+                // SAFETY: nvr elements each, per FMI (only NULL-ness of `value` is used).
+                let vr = unsafe { slice(vr, nvr, "vr")? };
+                if nvr > 0 && value.is_null() {
+                    return Err("value is NULL".into());
+                }
+                no_such($func, vr)
+            })
+        }
+    )*};
+}
+
+no_variables! {
+    /// fmi2GetInteger (2.1.7): no Integer variables.
+    fmi2GetInteger, Func::GetInteger, *mut Integer;
+    /// fmi2GetBoolean (2.1.7): no Boolean variables.
+    fmi2GetBoolean, Func::GetBoolean, *mut Boolean;
+    /// fmi2GetString (2.1.7): no String variables.
+    fmi2GetString, Func::GetString, *mut FmiString;
+    /// fmi2SetInteger (2.1.7): no Integer variables.
+    fmi2SetInteger, Func::SetInteger, *const Integer;
+    /// fmi2SetBoolean (2.1.7): no Boolean variables.
+    fmi2SetBoolean, Func::SetBoolean, *const Boolean;
+    /// fmi2SetString (2.1.7): no String variables.
+    fmi2SetString, Func::SetString, *const FmiString;
+}
+
+/// The messages an instance logged recently (those that passed its log filter).
+///
+/// # Safety
+/// `c` is NULL or a live instance from fmi2Instantiate not used concurrently.
+#[doc(hidden)]
+pub unsafe fn last_messages(c: Component) -> Vec<String> {
+    if c.is_null() {
+        return Vec::new();
+    }
+    // SAFETY: per this function's contract.
+    unsafe { &*c.cast::<Instance>() }.log.recent()
+}
+
+/// The instance's state-machine state (tests, diagnostics).
+///
+/// # Safety
+/// As [`last_messages`].
+#[doc(hidden)]
+pub unsafe fn instance_state(c: Component) -> Option<State> {
+    // SAFETY: per this function's contract.
+    (!c.is_null()).then(|| unsafe { &*c.cast::<Instance>() }.state)
+}

@@ -1,0 +1,315 @@
+//! One FMU instance: the model, the values the host set, the experiment, and the engine
+//! once initialized. It knows the FMI rules for values (who may set what, when); the
+//! exports only translate pointers and statuses.
+
+use super::logger::Logger;
+use super::state_machine::State;
+use super::types::Status;
+use super::variables::{Target, Variable, variables};
+use crate::dae::{SimOptions, Simulator};
+use crate::model::Model;
+
+/// What the host chose: parameter and input values, input slopes, experiment.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Config {
+    pub params: Vec<f64>,
+    pub inputs: Vec<f64>,
+    pub slopes: Vec<f64>,
+    pub tol: f64,
+    pub start: f64,
+    pub stop: Option<f64>,
+}
+
+/// The engine, with the configuration it was built from.
+pub struct Built {
+    pub sim: Simulator,
+    pub params: Vec<f64>,
+    pub tol: f64,
+}
+
+/// Outcome of fmi2DoStep once its arguments are valid.
+pub enum Step {
+    Done,
+    /// The engine stopped early (fmi2Discard), with its message.
+    Failed(String),
+}
+
+/// An FMU instance (the fmi2Component).
+pub struct Instance {
+    pub log: Logger,
+    pub state: State,
+    /// GUID of the model text: identifies whose FMU states this instance accepts.
+    pub guid: String,
+    base: Model,
+    vars: Vec<Variable>,
+    pub config: Config,
+    pub built: Option<Built>,
+    /// Values changed since the engine was built (rebuild before use).
+    pub dirty: bool,
+    /// fmi2LastSuccessfulTime.
+    pub last_time: f64,
+}
+
+impl Instance {
+    /// A fresh instance (state Instantiated) of a parsed model.
+    pub fn new(base: Model, guid: String, log: Logger) -> Instance {
+        let vars = variables(&base);
+        let config = Self::default_config(&base);
+        let last_time = config.start;
+        Instance { log, state: State::Instantiated, guid, base, vars, config, built: None, dirty: true, last_time }
+    }
+
+    fn default_config(m: &Model) -> Config {
+        Config {
+            params: m.param_values(),
+            inputs: m.inputs.iter().map(|i| i.start.value).collect(),
+            slopes: vec![0.0; m.inputs.len()],
+            tol: m.experiment.tolerance.unwrap_or(SimOptions::default().tol),
+            start: m.experiment.start.unwrap_or(0.0),
+            stop: None,
+        }
+    }
+
+    /// fmi2Reset: back to the state after fmi2Instantiate (logging settings kept).
+    pub fn reset(&mut self) {
+        self.config = Self::default_config(&self.base);
+        self.built = None;
+        self.dirty = true;
+        self.last_time = self.config.start;
+        self.state = State::Instantiated;
+    }
+
+    /// fmi2SetupExperiment (tolerance None: the model's).
+    pub fn setup(&mut self, tol: Option<f64>, start: f64, stop: Option<f64>) -> Result<(), String> {
+        if let Some(t) = tol {
+            if !(t.is_finite() && t > 0.0) {
+                return Err(format!("tolerance {t} is not a positive number"));
+            }
+            self.config.tol = t;
+        }
+        if !start.is_finite() {
+            return Err(format!("startTime {start} is not finite"));
+        }
+        if let Some(s) = stop
+            && !(s.is_finite() && s >= start)
+        {
+            return Err(format!("stopTime {s} is not a finite time after startTime {start}"));
+        }
+        self.config.start = start;
+        self.config.stop = stop;
+        self.last_time = start;
+        self.dirty = true;
+        Ok(())
+    }
+
+    /// The variable of value reference `vr`.
+    pub fn var(&self, vr: u32) -> Result<&Variable, String> {
+        self.vars
+            .get(vr as usize)
+            .filter(|v| v.value_reference == vr)
+            .ok_or_else(|| format!("unknown value reference {vr}"))
+    }
+
+    /// The engine for the current values, built (assembled at the start time) when it is
+    /// missing or the values changed before initialization ended.
+    pub fn simulator(&mut self) -> Result<&mut Simulator, String> {
+        if self.built.is_none() || self.dirty {
+            self.built = Some(self.build(&self.config.clone())?);
+            self.dirty = false;
+        }
+        Ok(&mut self.built.as_mut().expect("just built").sim)
+    }
+
+    /// Build an engine for `cfg`: parameters re-evaluated, inputs and slopes applied.
+    pub fn build(&self, cfg: &Config) -> Result<Built, String> {
+        let mut model = if bits(&cfg.params) == bits(&self.base.param_values()) {
+            self.base.clone()
+        } else {
+            self.base.with_params(&cfg.params)?
+        };
+        for (i, &v) in model.inputs.iter_mut().zip(&cfg.inputs) {
+            i.start.value = v;
+        }
+        let mut sim = Simulator::new(&model, SimOptions { tol: cfg.tol, max_step: None }, cfg.start)
+            .map_err(|e| format!("the model cannot be initialized: {e}"))?;
+        for (k, &s) in cfg.slopes.iter().enumerate() {
+            if s != 0.0 {
+                sim.set_input_derivative(k, s);
+            }
+        }
+        Ok(Built { sim, params: cfg.params.clone(), tol: cfg.tol })
+    }
+
+    /// fmi2GetReal: values of `vrs` into `out`.
+    pub fn get_reals(&mut self, vrs: &[u32], out: &mut [f64]) -> Result<(), String> {
+        let targets = vrs.iter().map(|&vr| Ok(self.var(vr)?.target)).collect::<Result<Vec<Target>, String>>()?;
+        let mut outputs = None;
+        let mut inputs = None;
+        for (t, o) in targets.iter().zip(out.iter_mut()) {
+            *o = match *t {
+                Target::Parameter(k) => self.config.params[k],
+                Target::Input(k) if self.initialized() => {
+                    inputs.get_or_insert_with(|| self.built.as_ref().expect("initialized").sim.inputs())[k]
+                }
+                Target::Input(k) => self.config.inputs[k],
+                Target::Output(k) => {
+                    if outputs.is_none() {
+                        let sim = self.simulator()?;
+                        outputs = Some(sim.outputs().map_err(|e| format!("outputs cannot be evaluated: {e}"))?);
+                    }
+                    outputs.as_ref().expect("evaluated")[k]
+                }
+            };
+        }
+        Ok(())
+    }
+
+    /// Whether the engine runs (initialization has ended).
+    fn initialized(&self) -> bool {
+        !matches!(self.state, State::Instantiated | State::InitializationMode) && self.built.is_some()
+    }
+
+    /// fmi2SetReal: all checked first, then all applied (a refused call changes nothing).
+    pub fn set_reals(&mut self, vrs: &[u32], values: &[f64]) -> Result<(), String> {
+        let mut targets = Vec::with_capacity(vrs.len());
+        for (&vr, &v) in vrs.iter().zip(values) {
+            let var = self.var(vr)?;
+            if !v.is_finite() {
+                return Err(format!("value {v} for '{}' (vr {vr}) is not finite", var.name));
+            }
+            match var.target {
+                Target::Output(_) => return Err(format!("'{}' (vr {vr}) is an output and cannot be set", var.name)),
+                Target::Parameter(_) if self.initialized() => {
+                    return Err(format!(
+                        "parameter '{}' (vr {vr}) cannot be set after initialization (state {:?})",
+                        var.name, self.state
+                    ));
+                }
+                t => targets.push((t, v)),
+            }
+        }
+        for (t, v) in targets {
+            match t {
+                Target::Parameter(k) => {
+                    self.config.params[k] = v;
+                    self.dirty = true;
+                }
+                Target::Input(k) => {
+                    self.config.inputs[k] = v;
+                    self.config.slopes[k] = 0.0;
+                    if self.initialized() {
+                        self.built.as_mut().expect("initialized").sim.set_input(k, v);
+                    } else {
+                        self.dirty = true;
+                    }
+                }
+                Target::Output(_) => unreachable!("refused above"),
+            }
+        }
+        Ok(())
+    }
+
+    /// fmi2SetRealInputDerivatives (order 1 only: inputs change linearly over a step).
+    pub fn set_input_derivatives(&mut self, vrs: &[u32], orders: &[i32], values: &[f64]) -> Result<(), String> {
+        let mut todo = Vec::with_capacity(vrs.len());
+        for ((&vr, &order), &v) in vrs.iter().zip(orders).zip(values) {
+            let var = self.var(vr)?;
+            let Target::Input(k) = var.target else {
+                return Err(format!("'{}' (vr {vr}) is not an input", var.name));
+            };
+            if order != 1 {
+                return Err(format!(
+                    "derivative order {order} for '{}' (vr {vr}): only order 1 is supported",
+                    var.name
+                ));
+            }
+            if !v.is_finite() {
+                return Err(format!("derivative {v} for '{}' (vr {vr}) is not finite", var.name));
+            }
+            todo.push((k, v));
+        }
+        for (k, v) in todo {
+            self.config.slopes[k] = v;
+            if self.initialized() {
+                self.built.as_mut().expect("initialized").sim.set_input_derivative(k, v);
+            } else {
+                self.dirty = true;
+            }
+        }
+        Ok(())
+    }
+
+    /// fmi2ExitInitializationMode: build the engine with the values set (parameters
+    /// re-evaluated); on failure the instance stays in initialization mode.
+    pub fn exit_initialization(&mut self) -> Result<(), String> {
+        let t = self.simulator()?.time();
+        self.last_time = t;
+        self.state = State::StepComplete;
+        Ok(())
+    }
+
+    /// fmi2DoStep from `t` over `h`.
+    pub fn do_step(&mut self, t: f64, h: f64) -> Result<Step, String> {
+        if !(h.is_finite() && h >= 0.0) {
+            return Err(format!("communicationStepSize {h} is not a non-negative number"));
+        }
+        let stop = self.config.stop;
+        let sim = &mut self.built.as_mut().ok_or("no engine (not initialized)")?.sim;
+        let now = sim.time();
+        if !t.is_finite() || (t - now).abs() > 1e-9 * now.abs().max(1.0) {
+            return Err(format!("currentCommunicationPoint {t} is not the current time {now}"));
+        }
+        let target = t + h;
+        if let Some(s) = stop
+            && target > s + 1e-9 * s.abs().max(1.0)
+        {
+            return Err(format!("step to {target} goes beyond stopTime {s}"));
+        }
+        match sim.advance(target) {
+            Ok(()) => {
+                self.last_time = sim.time();
+                Ok(Step::Done)
+            }
+            Err(e) => {
+                self.last_time = sim.time();
+                self.state = State::StepFailed;
+                Ok(Step::Failed(format!("step from {t} to {target} stopped at {}: {e}", self.last_time)))
+            }
+        }
+    }
+
+    /// fmi2GetRealOutputDerivatives (order 1).
+    pub fn output_derivatives(&mut self, vrs: &[u32], orders: &[i32], out: &mut [f64]) -> Result<(), String> {
+        let mut ks = Vec::with_capacity(vrs.len());
+        for (&vr, &order) in vrs.iter().zip(orders) {
+            let var = self.var(vr)?;
+            let Target::Output(k) = var.target else {
+                return Err(format!("'{}' (vr {vr}) is not an output", var.name));
+            };
+            if order != 1 {
+                return Err(format!(
+                    "derivative order {order} for '{}' (vr {vr}): only order 1 is supported",
+                    var.name
+                ));
+            }
+            ks.push(k);
+        }
+        if ks.is_empty() {
+            return Ok(());
+        }
+        let d = self.simulator()?.output_derivatives().map_err(|e| e.to_string())?;
+        for (o, k) in out.iter_mut().zip(ks) {
+            *o = d[k];
+        }
+        Ok(())
+    }
+
+    /// Log a message through the host's logger.
+    pub fn log(&mut self, status: Status, msg: &str) {
+        self.log.log(status, msg);
+    }
+}
+
+fn bits(v: &[f64]) -> Vec<u64> {
+    v.iter().map(|x| x.to_bits()).collect()
+}

@@ -1,0 +1,77 @@
+//! FMI 2.0 C types (fmi2TypesPlatform.h, fmi2FunctionTypes.h) in Rust, with `libc` scalars.
+//! C enums the host passes in (fmi2Type, fmi2StatusKind) arrive as `c_int` and are checked,
+//! never transmuted.
+
+use libc::{c_char, c_int, c_uint, c_void, size_t};
+
+/// fmi2Component: the instance pointer returned by fmi2Instantiate.
+pub type Component = *mut c_void;
+/// fmi2ComponentEnvironment: the host's opaque pointer, handed back to the logger.
+pub type ComponentEnvironment = *mut c_void;
+/// fmi2FMUstate: an opaque pointer to a saved FMU state.
+pub type FmuStatePtr = *mut c_void;
+/// fmi2ValueReference.
+pub type ValueReference = c_uint;
+/// fmi2Real.
+pub type Real = f64;
+/// fmi2Integer.
+pub type Integer = c_int;
+/// fmi2Boolean (fmi2True = 1, fmi2False = 0).
+pub type Boolean = c_int;
+/// fmi2String.
+pub type FmiString = *const c_char;
+/// fmi2Byte.
+pub type Byte = c_char;
+
+/// fmi2True.
+pub const TRUE: Boolean = 1;
+/// fmi2False.
+pub const FALSE: Boolean = 0;
+
+/// fmi2Status (2.1.3 Status Returned by Functions).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Status {
+    Ok = 0,
+    Warning = 1,
+    Discard = 2,
+    Error = 3,
+    Fatal = 4,
+    Pending = 5,
+}
+
+/// fmi2Type value fmi2ModelExchange.
+pub const MODEL_EXCHANGE: c_int = 0;
+/// fmi2Type value fmi2CoSimulation.
+pub const CO_SIMULATION: c_int = 1;
+
+/// fmi2StatusKind value fmi2DoStepStatus (4.2.3 Retrieving Status Information from the Slave).
+pub const DO_STEP_STATUS: c_int = 0;
+/// fmi2StatusKind value fmi2PendingStatus.
+pub const PENDING_STATUS: c_int = 1;
+/// fmi2StatusKind value fmi2LastSuccessfulTime.
+pub const LAST_SUCCESSFUL_TIME: c_int = 2;
+/// fmi2StatusKind value fmi2Terminated.
+pub const TERMINATED: c_int = 3;
+
+/// fmi2CallbackLogger: `(env, instanceName, status, category, message, ...)`; the message
+/// is a printf format, so it is always called with `"%s"` and the text.
+pub type LoggerFn = unsafe extern "C" fn(ComponentEnvironment, FmiString, c_int, FmiString, FmiString, ...);
+/// fmi2CallbackAllocateMemory.
+pub type AllocateMemoryFn = unsafe extern "C" fn(size_t, size_t) -> *mut c_void;
+/// fmi2CallbackFreeMemory.
+pub type FreeMemoryFn = unsafe extern "C" fn(*mut c_void);
+/// fmi2StepFinished.
+pub type StepFinishedFn = unsafe extern "C" fn(ComponentEnvironment, c_int);
+
+/// fmi2CallbackFunctions (2.1.5 Creation, Destruction and Logging of FMU Instances).
+/// NULL function pointers are `None`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct CallbackFunctions {
+    pub logger: Option<LoggerFn>,
+    pub allocate_memory: Option<AllocateMemoryFn>,
+    pub free_memory: Option<FreeMemoryFn>,
+    pub step_finished: Option<StepFinishedFn>,
+    pub component_environment: ComponentEnvironment,
+}
