@@ -3,4 +3,5 @@
 //! nothing itself.
 
 pub mod guid;
+pub mod model_description;
 pub mod variables;
