@@ -4,4 +4,5 @@
 
 pub mod guid;
 pub mod model_description;
+pub mod pack;
 pub mod variables;
