@@ -1,7 +1,8 @@
 //! `mbfmu pack`: the FMU's files, its GUID, and the command's exit codes.
 //!
-//! The packer embeds the crate's cdylib, which cargo builds next to the `mbfmu` binary
-//! (`target/<profile>/libmbfmu.so`) because the library's crate types include `cdylib`.
+//! The packer embeds the crate's cdylib, which cargo builds with the tests because the
+//! library's crate types include `cdylib` (`target/<profile>/deps/libmbfmu.so`; `cargo
+//! build` also puts it next to the `mbfmu` binary).
 
 use std::io::Read;
 use std::path::{Path, PathBuf};
@@ -33,9 +34,10 @@ fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
+/// The cdylib the packer embeds: this test executable runs from `target/<profile>/deps/`
+/// and the binary from `target/<profile>/`, and both search the same three places.
 fn library() -> PathBuf {
-    let exe = Path::new(env!("CARGO_BIN_EXE_mbfmu"));
-    exe.with_file_name(format!("{}mbfmu{}", std::env::consts::DLL_PREFIX, std::env::consts::DLL_SUFFIX))
+    mbfmu::fmi::pack::find_library().unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// Entries of a zip archive, name -> bytes, in archive order.
@@ -59,12 +61,9 @@ fn guid_of(xml: &str) -> String {
 }
 
 #[test]
-fn the_cdylib_is_built_next_to_the_binary() {
-    assert!(
-        library().is_file(),
-        "{} is missing: cargo should build the cdylib with the binary (crate-type includes cdylib)",
-        library().display()
-    );
+fn cargo_builds_the_cdylib_for_the_tests() {
+    // crate-type includes cdylib, so `cargo test` builds it (in target/<profile>/deps/).
+    assert!(library().is_file(), "{}", library().display());
 }
 
 #[test]

@@ -7,8 +7,7 @@
 //! ```
 //!
 //! The cdylib is found through the environment variable `MBFMU_LIB` (a file path), else
-//! as `libmbfmu.so` next to the running executable or in its parent directory (where
-//! `cargo` puts it when the executable is a test in `target/<profile>/deps/`).
+//! next to the running executable (see [`find_library`]).
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -76,8 +75,10 @@ pub fn library_file_name() -> String {
     format!("{}mbfmu{}", std::env::consts::DLL_PREFIX, std::env::consts::DLL_SUFFIX)
 }
 
-/// Locate the cdylib to embed: `MBFMU_LIB`, else next to the running executable, else in
-/// the executable's parent directory.
+/// Locate the cdylib to embed: `MBFMU_LIB`, else the newest of `libmbfmu.so` next to the
+/// running executable, in its `deps/` subdirectory, or in its parent directory. (`cargo
+/// build` puts the cdylib next to the binary; `cargo test` only updates `deps/`, and runs
+/// test executables from `deps/`.)
 pub fn find_library() -> Result<PathBuf, PackError> {
     if let Some(p) = std::env::var_os("MBFMU_LIB") {
         let p = PathBuf::from(p);
@@ -89,21 +90,25 @@ pub fn find_library() -> Result<PathBuf, PackError> {
     }
     let name = library_file_name();
     let exe = std::env::current_exe().map_err(io_err("locating the running executable"))?;
-    let mut tried = Vec::new();
-    let mut dir = exe.parent();
-    for _ in 0..2 {
-        let Some(d) = dir else { break };
-        let candidate = d.join(&name);
-        if candidate.is_file() {
-            return Ok(candidate);
-        }
-        tried.push(candidate.display().to_string());
-        dir = d.parent();
+    let dir = exe.parent().unwrap_or(Path::new("."));
+    let mut candidates = vec![dir.join(&name), dir.join("deps").join(&name)];
+    if let Some(parent) = dir.parent() {
+        candidates.push(parent.join(&name));
     }
-    Err(PackError::LibraryNotFound(format!(
-        "the FMU library {name} was not found (tried {}); build it with `cargo build --release` or set MBFMU_LIB",
-        tried.join(", ")
-    )))
+    let newest = candidates
+        .iter()
+        .filter_map(|p| {
+            let meta = std::fs::metadata(p).ok().filter(|m| m.is_file())?;
+            Some((meta.modified().ok(), p))
+        })
+        .max_by_key(|(modified, _)| *modified);
+    match newest {
+        Some((_, p)) => Ok(p.clone()),
+        None => Err(PackError::LibraryNotFound(format!(
+            "the FMU library {name} was not found (tried {}); build it with `cargo build --release` or set MBFMU_LIB",
+            candidates.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ")
+        ))),
+    }
 }
 
 /// Load the model and gather every file of its FMU.
