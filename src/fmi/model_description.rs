@@ -390,6 +390,18 @@ mod tests {
     }
 
     #[test]
+    fn a_model_without_outputs_or_units_has_an_empty_structure() {
+        let text = r#"<multibody name="bare" version="1">
+  <parameter name="m" value="2"/>
+  <body name="b" mass="m" inertia="1 1 1" position="0 0 0"/>
+</multibody>"#;
+        let model = crate::model::load_str(text, "bare.xml").unwrap_or_else(|e| panic!("{e}"));
+        let xml = write(&model, text);
+        assert!(xml.contains("  <ModelStructure/>\n</fmiModelDescription>\n"), "{xml}");
+        assert!(!xml.contains("UnitDefinitions") && !xml.contains("<Outputs"), "{xml}");
+    }
+
+    #[test]
     fn reals_round_trip_and_escaping() {
         for v in [0.0, 0.5, 1e-6, 9.80665, 170.0 * std::f64::consts::PI / 180.0, 1e300, -2.5e-12] {
             assert_eq!(real(v).parse::<f64>().ok(), Some(v), "{}", real(v));
