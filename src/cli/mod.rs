@@ -1,4 +1,4 @@
-//! The `mbfmu` command line: `check`, `simulate`, `run`. One file per command; `main.rs`
+//! The `mbfmu` command line: `check`, `simulate`, `pack`, `run`. One file per command; `main.rs`
 //! only calls [`main`].
 //!
 //! Exit codes: 0 success; 2 bad input (model error `file:line:col: element 'name': what is
@@ -7,6 +7,7 @@
 
 mod check;
 mod error;
+mod pack;
 mod run;
 mod simulate;
 
@@ -16,6 +17,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 pub use error::CliError;
+pub use pack::PackArgs;
 pub use simulate::{SimulateArgs, communication_points};
 
 /// Multibody model file -> simulation, FMI 2.0 FMU with exact linearization.
@@ -38,6 +40,9 @@ pub enum Command {
     /// Simulate a model and write time, every output (and with --states every q and u)
     /// as CSV.
     Simulate(SimulateArgs),
+    /// Build the model's FMI 2.0 Co-Simulation FMU: a zip file (-o) and/or an unzipped
+    /// directory (--out-dir).
+    Pack(PackArgs),
     /// Run the embedded default model (models/double_pendulum.xml) for 2 s and print a
     /// table of its outputs.
     Run,
@@ -82,6 +87,7 @@ pub fn execute(command: &Command) -> Result<(), CliError> {
     match command {
         Command::Check { model } => check::check(model, &mut out),
         Command::Simulate(args) => simulate::simulate(args, &mut out),
+        Command::Pack(args) => pack::run(args, &mut out),
         Command::Run => run::run(&mut out),
     }
 }

@@ -11,6 +11,8 @@ pub mod guard;
 pub mod guid;
 pub mod instance;
 pub mod logger;
+pub mod model_description;
+pub mod pack;
 pub mod state_machine;
 pub mod types;
 pub mod uri;

@@ -1,0 +1,44 @@
+//! `mbfmu pack model.xml -o model.fmu` and/or `--out-dir DIR`: build the model's FMI 2.0
+//! Co-Simulation FMU (see [`crate::fmi::pack`]).
+
+use std::io::Write;
+use std::path::PathBuf;
+
+use clap::{ArgGroup, Args};
+
+use super::CliError;
+use crate::fmi::pack::{PackError, pack};
+
+/// Arguments of `mbfmu pack` (at least one of `--out` and `--out-dir`).
+#[derive(Clone, Debug, Args)]
+#[command(group(ArgGroup::new("destination").required(true).multiple(true).args(["out", "out_dir"])))]
+pub struct PackArgs {
+    /// Model file (XML, see MODEL_FORMAT.md).
+    pub model: PathBuf,
+    /// Write the FMU (a zip archive) to this file.
+    #[arg(short = 'o', long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
+    /// Write the FMU's files, unzipped, into this directory.
+    #[arg(long, value_name = "DIR")]
+    pub out_dir: Option<PathBuf>,
+}
+
+impl From<PackError> for CliError {
+    fn from(e: PackError) -> Self {
+        match e {
+            PackError::Model(m) => CliError::Model(m),
+            PackError::Io { context, source } => CliError::Io { context, source },
+            PackError::LibraryNotFound(msg) => {
+                CliError::io("locating the FMU library", std::io::Error::new(std::io::ErrorKind::NotFound, msg))
+            }
+        }
+    }
+}
+
+/// Pack the FMU and print one line: modelIdentifier, GUID and where it was written.
+pub fn run(args: &PackArgs, out: &mut dyn Write) -> Result<(), CliError> {
+    let packed = pack(&args.model, args.out.as_deref(), args.out_dir.as_deref())?;
+    let dest: Vec<String> = args.out.iter().chain(&args.out_dir).map(|p| p.display().to_string()).collect();
+    writeln!(out, "packed FMU '{}' guid {} -> {}", packed.model_identifier, packed.guid, dest.join(", "))
+        .map_err(|e| CliError::io("writing to stdout", e))
+}

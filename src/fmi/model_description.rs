@@ -1,0 +1,414 @@
+//! `modelDescription.xml` of a model's FMI 2.0 Co-Simulation FMU.
+//!
+//! The variables and their value references come from [`super::variables`] (shared with
+//! the C API). Dependencies in `<ModelStructure>` are derived from the output expressions:
+//!
+//! - At communication points (`<Outputs>`) the knowns are the inputs (no states are
+//!   exposed). Positions and velocities are states of the integrator, so an output depends
+//!   on an input only through the input's direct use in the output, through the loads of
+//!   force elements whose functions use it, or through accelerations (an acceleration
+//!   measure or a joint, motion or constraint load): then on every input that a force uses.
+//! - In Initialization Mode (`<InitialUnknowns>`) the knowns are also the parameters
+//!   (`initial="exact"`): setting one re-evaluates the whole model, so every output depends
+//!   on every parameter, and with `<analysis static="true"/>` the equilibrium positions
+//!   depend on every input a force uses.
+
+use std::collections::BTreeSet;
+use std::fmt::Write as _;
+
+use super::guid::{ENGINE_VERSION, guid, model_identifier};
+use super::variables::{Causality, Target, Variable, variables};
+use crate::model::Model;
+use crate::model::expr::{ElementRef, Expr, deps};
+
+/// The modelDescription.xml of the FMU of `model`, whose file text is `model_text` (it
+/// determines the GUID, see [`guid`]).
+pub fn write(model: &Model, model_text: &str) -> String {
+    let vars = variables(model);
+    let mut x = String::new();
+    x.push_str("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
+    x.push_str("<fmiModelDescription\n");
+    attr_line(&mut x, "fmiVersion", "2.0");
+    attr_line(&mut x, "modelName", &model.name);
+    attr_line(&mut x, "guid", &guid(model_text));
+    attr_line(&mut x, "description", &format!("Multibody model {}", model.name));
+    attr_line(&mut x, "generationTool", &format!("mbfmu {ENGINE_VERSION}"));
+    attr_line(&mut x, "variableNamingConvention", "structured");
+    x.push_str("  numberOfEventIndicators=\"0\">\n");
+
+    x.push_str("  <CoSimulation\n");
+    let id = model_identifier(&model.name);
+    for (name, value) in [
+        ("modelIdentifier", id.as_str()),
+        ("canHandleVariableCommunicationStepSize", "true"),
+        ("canGetAndSetFMUstate", "true"),
+        ("canSerializeFMUstate", "true"),
+        ("canInterpolateInputs", "true"),
+        ("maxOutputDerivativeOrder", "1"),
+        ("canNotUseMemoryManagementFunctions", "true"),
+    ] {
+        x.push_str("  ");
+        attr_line(&mut x, name, value);
+    }
+    x.push_str("    providesDirectionalDerivative=\"false\"/>\n");
+
+    write_units(&mut x, &vars);
+    write_experiment(&mut x, model);
+
+    x.push_str("  <ModelVariables>\n");
+    for (k, v) in vars.iter().enumerate() {
+        write_variable(&mut x, k + 1, v);
+    }
+    x.push_str("  </ModelVariables>\n");
+
+    write_structure(&mut x, model, &vars);
+    x.push_str("</fmiModelDescription>\n");
+    x
+}
+
+/// `    name="value"` and a newline (attributes of a multi-line start tag).
+fn attr_line(x: &mut String, name: &str, value: &str) {
+    let _ = writeln!(x, "  {name}=\"{}\"", escape(value));
+}
+
+/// Escape text for a double-quoted XML attribute value.
+fn escape(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&apos;"),
+            '\t' => out.push_str("&#9;"),
+            '\n' => out.push_str("&#10;"),
+            '\r' => out.push_str("&#13;"),
+            // Not representable in XML 1.0: drop.
+            c if (c as u32) < 0x20 => {}
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+/// An `xs:double` literal that reads back to the same `f64`: the shorter of Rust's two
+/// round-trip formats (`0.5`, `1e-6`), `INF`, `-INF` or `NaN`.
+fn real(v: f64) -> String {
+    if v.is_nan() {
+        return "NaN".into();
+    }
+    if v.is_infinite() {
+        return if v > 0.0 { "INF".into() } else { "-INF".into() };
+    }
+    let (display, debug) = (format!("{v}"), format!("{v:?}"));
+    if debug.len() < display.len() { debug } else { display }
+}
+
+fn write_units(x: &mut String, vars: &[Variable]) {
+    let units: BTreeSet<&str> = vars.iter().filter_map(|v| v.unit.as_deref()).collect();
+    if units.is_empty() {
+        return;
+    }
+    x.push_str("  <UnitDefinitions>\n");
+    for u in units {
+        match base_unit(u) {
+            Some(exps) => {
+                let _ = writeln!(x, "    <Unit name=\"{}\">", escape(u));
+                x.push_str("      <BaseUnit");
+                for (name, e) in BASE_NAMES.iter().zip(exps) {
+                    if e != 0 {
+                        let _ = write!(x, " {name}=\"{e}\"");
+                    }
+                }
+                x.push_str("/>\n    </Unit>\n");
+            }
+            None => {
+                let _ = writeln!(x, "    <Unit name=\"{}\"/>", escape(u));
+            }
+        }
+    }
+    x.push_str("  </UnitDefinitions>\n");
+}
+
+/// The SI base units of `<BaseUnit>`, in schema order.
+const BASE_NAMES: [&str; 8] = ["kg", "m", "s", "A", "K", "mol", "cd", "rad"];
+
+/// Exponents of a unit symbol, in [`BASE_NAMES`] order.
+fn symbol(s: &str) -> Option<[i32; 8]> {
+    Some(match s {
+        "kg" => [1, 0, 0, 0, 0, 0, 0, 0],
+        "m" => [0, 1, 0, 0, 0, 0, 0, 0],
+        "s" => [0, 0, 1, 0, 0, 0, 0, 0],
+        "A" => [0, 0, 0, 1, 0, 0, 0, 0],
+        "K" => [0, 0, 0, 0, 1, 0, 0, 0],
+        "mol" => [0, 0, 0, 0, 0, 1, 0, 0],
+        "cd" => [0, 0, 0, 0, 0, 0, 1, 0],
+        "rad" => [0, 0, 0, 0, 0, 0, 0, 1],
+        "N" => [1, 1, -2, 0, 0, 0, 0, 0],
+        "J" => [1, 2, -2, 0, 0, 0, 0, 0],
+        "W" => [1, 2, -3, 0, 0, 0, 0, 0],
+        "Pa" => [1, -1, -2, 0, 0, 0, 0, 0],
+        "Hz" => [0, 0, -1, 0, 0, 0, 0, 0],
+        _ => return None,
+    })
+}
+
+/// SI exponents of a unit in the FMI/Modelica syntax `N.m.s/rad`, `kg.m2`, `m/s2`
+/// (factors joined by `.`, at most one `/`, integer exponents); `None` if it uses
+/// anything else. Dimensionless units (all exponents 0) are `None` too.
+fn base_unit(unit: &str) -> Option<[i32; 8]> {
+    let (num, den) = match unit.split_once('/') {
+        Some((n, d)) => (n, Some(d)),
+        None => (unit, None),
+    };
+    let mut exps = [0i32; 8];
+    for (part, sign) in [(Some(num), 1), (den, -1)] {
+        let Some(part) = part else { continue };
+        for factor in part.split('.') {
+            let split = factor.find(|c: char| c.is_ascii_digit() || c == '-').unwrap_or(factor.len());
+            let (sym, pow) = factor.split_at(split);
+            let pow: i32 = if pow.is_empty() { 1 } else { pow.parse().ok()? };
+            let e = symbol(sym)?;
+            for (acc, b) in exps.iter_mut().zip(e) {
+                *acc += sign * pow * b;
+            }
+        }
+    }
+    exps.iter().any(|e| *e != 0).then_some(exps)
+}
+
+fn write_experiment(x: &mut String, model: &Model) {
+    let e = &model.experiment;
+    let attrs: Vec<String> =
+        [("startTime", e.start), ("stopTime", e.stop), ("tolerance", e.tolerance), ("stepSize", e.step)]
+            .into_iter()
+            .filter_map(|(n, v)| v.map(|v| format!(" {n}=\"{}\"", real(v))))
+            .collect();
+    if !attrs.is_empty() {
+        let _ = writeln!(x, "  <DefaultExperiment{}/>", attrs.concat());
+    }
+}
+
+fn write_variable(x: &mut String, index: usize, v: &Variable) {
+    let (causality, variability, initial) = match v.causality {
+        Causality::Parameter => ("parameter", "fixed", Some("exact")),
+        Causality::Input => ("input", "continuous", None),
+        Causality::Output => ("output", "continuous", Some("calculated")),
+    };
+    let _ = writeln!(x, "    <!-- index {index} -->");
+    let _ = write!(
+        x,
+        "    <ScalarVariable name=\"{}\" valueReference=\"{}\" causality=\"{causality}\" variability=\"{variability}\"",
+        escape(&v.name),
+        v.value_reference
+    );
+    if let Some(i) = initial {
+        let _ = write!(x, " initial=\"{i}\"");
+    }
+    if let Some(d) = &v.description {
+        let _ = write!(x, " description=\"{}\"", escape(d));
+    }
+    x.push_str(">\n      <Real");
+    if let Some(u) = &v.unit {
+        let _ = write!(x, " unit=\"{}\"", escape(u));
+    }
+    // Outputs are calculated: a start value is not allowed.
+    if let (Some(s), false) = (v.start, v.causality == Causality::Output) {
+        let _ = write!(x, " start=\"{}\"", real(s));
+    }
+    x.push_str("/>\n    </ScalarVariable>\n");
+}
+
+/// Inputs used by force elements: accelerations and constraint loads depend on these.
+fn force_inputs(model: &Model) -> BTreeSet<usize> {
+    let mut s = BTreeSet::new();
+    for f in &model.sforces {
+        s.extend(deps(&f.function).inputs);
+    }
+    for g in &model.gforces {
+        for e in g.force.iter().chain(&g.torque) {
+            s.extend(deps(e).inputs);
+        }
+    }
+    s
+}
+
+/// Inputs (indices into `Model::inputs`) that an output expression depends on at a
+/// communication point; see the module documentation.
+pub fn output_input_deps(model: &Model, e: &Expr) -> BTreeSet<usize> {
+    let d = deps(e);
+    let mut s: BTreeSet<usize> = d.inputs.iter().copied().collect();
+    let mut through_accelerations = d.level >= 2;
+    for r in &d.loads {
+        match *r {
+            ElementRef::Joint(_) | ElementRef::Motion(_) | ElementRef::Constraint(_) => through_accelerations = true,
+            ElementRef::SpringDamper(_) => {}
+            ElementRef::Sforce(k) => {
+                if let Some(f) = model.sforces.get(k) {
+                    s.extend(deps(&f.function).inputs);
+                }
+            }
+            ElementRef::Gforce(k) => {
+                if let Some(g) = model.gforces.get(k) {
+                    for e in g.force.iter().chain(&g.torque) {
+                        s.extend(deps(e).inputs);
+                    }
+                }
+            }
+        }
+    }
+    if through_accelerations {
+        s.extend(force_inputs(model));
+    }
+    s
+}
+
+/// `<Unknown index dependencies dependenciesKind/>` with 1-based `deps`.
+fn unknown(x: &mut String, index: usize, deps: &BTreeSet<usize>) {
+    let list: Vec<String> = deps.iter().map(|d| d.to_string()).collect();
+    let kinds = vec!["dependent"; deps.len()];
+    let _ = writeln!(
+        x,
+        "      <Unknown index=\"{index}\" dependencies=\"{}\" dependenciesKind=\"{}\"/>",
+        list.join(" "),
+        kinds.join(" ")
+    );
+}
+
+fn write_structure(x: &mut String, model: &Model, vars: &[Variable]) {
+    // FMI index (1-based ModelVariables position) of each parameter and input.
+    let mut param_index = Vec::new();
+    let mut input_index = vec![0; model.inputs.len()];
+    let mut outputs = Vec::new();
+    for (k, v) in vars.iter().enumerate() {
+        match v.target {
+            Target::Parameter(_) => param_index.push(k + 1),
+            Target::Input(i) => input_index[i] = k + 1,
+            Target::Output(o) => outputs.push((k + 1, o)),
+        }
+    }
+    if outputs.is_empty() {
+        x.push_str("  <ModelStructure/>\n");
+        return;
+    }
+    let to_fmi =
+        |s: &BTreeSet<usize>| -> BTreeSet<usize> { s.iter().filter_map(|i| input_index.get(*i).copied()).collect() };
+    let step_deps: Vec<BTreeSet<usize>> =
+        outputs.iter().map(|(_, o)| to_fmi(&output_input_deps(model, &model.outputs[*o].function))).collect();
+    let static_inputs = if model.static_analysis { to_fmi(&force_inputs(model)) } else { BTreeSet::new() };
+
+    x.push_str("  <ModelStructure>\n    <Outputs>\n");
+    for ((index, _), d) in outputs.iter().zip(&step_deps) {
+        unknown(x, *index, d);
+    }
+    x.push_str("    </Outputs>\n    <InitialUnknowns>\n");
+    // Outputs are already in index order.
+    for ((index, _), d) in outputs.iter().zip(&step_deps) {
+        let mut init: BTreeSet<usize> = param_index.iter().copied().collect();
+        init.extend(d);
+        init.extend(&static_inputs);
+        unknown(x, *index, &init);
+    }
+    x.push_str("    </InitialUnknowns>\n  </ModelStructure>\n");
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn units_decompose_into_si_exponents() {
+        assert_eq!(base_unit("N.m"), Some([1, 2, -2, 0, 0, 0, 0, 0]));
+        assert_eq!(base_unit("N.m.s/rad"), Some([1, 2, -1, 0, 0, 0, 0, -1]));
+        assert_eq!(base_unit("kg.m2"), Some([1, 2, 0, 0, 0, 0, 0, 0]));
+        assert_eq!(base_unit("m/s2"), Some([0, 1, -2, 0, 0, 0, 0, 0]));
+        assert_eq!(base_unit("N.s/m"), Some([1, 0, -1, 0, 0, 0, 0, 0]));
+        assert_eq!(base_unit("mol"), Some([0, 0, 0, 0, 0, 1, 0, 0]));
+        assert_eq!(base_unit("furlong"), None);
+        assert_eq!(base_unit("m/s/s"), None);
+        assert_eq!(base_unit(""), None);
+        assert_eq!(base_unit("m/m"), None);
+    }
+
+    /// A slider with three inputs: `u` drives an sforce, `v` a gforce, `w` only an output.
+    const INPUTS: &str = r#"<multibody name="inputs" version="1">
+  <parameter name="m" value="2" unit="kg" description="mass &amp; more"/>
+  <parameter name="k" value="3"/>
+  <ground><marker name="O" position="0 0 0"/></ground>
+  <body name="b" mass="m" inertia="1 1 1" position="0 0 0"/>
+  <joint name="j" type="translational" i="b.cm" j="ground.O"/>
+  <input name="u" start="1.5" unit="N"/>
+  <input name="v"/>
+  <input name="w" unit="furlong"/>
+  <sforce name="f" type="translational" i="b.cm" j="ground.O" function="u*k"/>
+  <gforce name="g" i="b.cm" force="0, 0, v" torque="0 0 0"/>
+  <output name="pos" function="dz(b.cm)" unit="m"/>
+  <output name="direct" function="w + vz(b.cm)"/>
+  <output name="acc" function="accz(b.cm)" unit="m/s2"/>
+  <output name="reaction" function="fz(j)"/>
+  <output name="force" function="fz(f) + w"/>
+</multibody>"#;
+
+    #[test]
+    fn dependencies_follow_inputs_through_forces_and_accelerations() {
+        let model = crate::model::load_str(INPUTS, "inputs.xml").unwrap_or_else(|e| panic!("{e}"));
+        let d: Vec<Vec<usize>> =
+            model.outputs.iter().map(|o| output_input_deps(&model, &o.function).into_iter().collect()).collect();
+        assert_eq!(d, [vec![], vec![2], vec![0, 1], vec![0, 1], vec![0, 2]]);
+        let xml = write(&model, INPUTS);
+        // Indices: m 1, k 2, u 3, v 4, w 5, pos 6, direct 7, acc 8, reaction 9, force 10.
+        let outputs = xml.split("<Outputs>").nth(1).and_then(|s| s.split("</Outputs>").next()).unwrap_or_default();
+        assert!(outputs.contains(r#"<Unknown index="6" dependencies="" dependenciesKind=""/>"#), "{xml}");
+        assert!(outputs.contains(r#"<Unknown index="7" dependencies="5" dependenciesKind="dependent"/>"#));
+        assert!(outputs.contains(r#"<Unknown index="8" dependencies="3 4" dependenciesKind="dependent dependent"/>"#));
+        assert!(outputs.contains(r#"<Unknown index="10" dependencies="3 5" dependenciesKind="dependent dependent"/>"#));
+        let init = xml.split("<InitialUnknowns>").nth(1).unwrap_or_default();
+        assert!(init.contains(r#"<Unknown index="6" dependencies="1 2" dependenciesKind="dependent dependent"/>"#));
+        assert!(init.contains(r#"<Unknown index="8" dependencies="1 2 3 4" "#));
+        assert!(
+            xml.contains(r#"<ScalarVariable name="u" valueReference="2" causality="input" variability="continuous">"#)
+        );
+        assert!(xml.contains(r#"<Real unit="N" start="1.5"/>"#));
+        assert!(xml.contains(r#"description="mass &amp; more""#));
+        assert!(xml.contains(r#"modelIdentifier="inputs""#));
+        assert!(xml.contains(r#"<Unit name="furlong"/>"#));
+        assert!(!xml.contains("<DefaultExperiment"));
+        let units: Vec<&str> =
+            xml.lines().filter_map(|l| l.trim().strip_prefix("<Unit name=\"")?.split('"').next()).collect();
+        assert_eq!(units, ["N", "furlong", "kg", "m", "m/s2"]);
+    }
+
+    #[test]
+    fn static_analysis_makes_initial_outputs_depend_on_force_inputs() {
+        let text = INPUTS.replace("<output name=\"pos\"", "<analysis static=\"true\"/><output name=\"pos\"");
+        let model = crate::model::load_str(&text, "inputs.xml").unwrap_or_else(|e| panic!("{e}"));
+        let xml = write(&model, &text);
+        let init = xml.split("<InitialUnknowns>").nth(1).unwrap_or_default();
+        assert!(init.contains(r#"<Unknown index="6" dependencies="1 2 3 4" "#), "{xml}");
+        assert!(init.contains(r#"<Unknown index="7" dependencies="1 2 3 4 5" "#), "{xml}");
+    }
+
+    #[test]
+    fn a_model_without_outputs_or_units_has_an_empty_structure() {
+        let text = r#"<multibody name="bare" version="1">
+  <parameter name="m" value="2"/>
+  <body name="b" mass="m" inertia="1 1 1" position="0 0 0"/>
+</multibody>"#;
+        let model = crate::model::load_str(text, "bare.xml").unwrap_or_else(|e| panic!("{e}"));
+        let xml = write(&model, text);
+        assert!(xml.contains("  <ModelStructure/>\n</fmiModelDescription>\n"), "{xml}");
+        assert!(!xml.contains("UnitDefinitions") && !xml.contains("<Outputs"), "{xml}");
+    }
+
+    #[test]
+    fn reals_round_trip_and_escaping() {
+        for v in [0.0, 0.5, 1e-6, 9.80665, 170.0 * std::f64::consts::PI / 180.0, 1e300, -2.5e-12] {
+            assert_eq!(real(v).parse::<f64>().ok(), Some(v), "{}", real(v));
+        }
+        assert_eq!(real(1e-6), "1e-6");
+        assert_eq!(real(8.2), "8.2");
+        assert_eq!(real(0.0), "0");
+        assert_eq!(escape("a<b & \"c\"\n"), "a&lt;b &amp; &quot;c&quot;&#10;");
+    }
+}

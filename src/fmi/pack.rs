@@ -1,0 +1,214 @@
+//! Pack a model file into an FMI 2.0 Co-Simulation FMU:
+//!
+//! ```text
+//! modelDescription.xml
+//! binaries/<platform>/<modelIdentifier>.<ext>   a copy of this crate's cdylib
+//! resources/model.xml                           the model file, byte for byte
+//! ```
+//!
+//! The cdylib is found through the environment variable `MBFMU_LIB` (a file path), else
+//! next to the running executable (see [`find_library`]).
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use zip::CompressionMethod;
+use zip::write::SimpleFileOptions;
+
+use super::guid::{guid, model_identifier};
+use super::model_description;
+use crate::model::{ModelError, load_str};
+
+/// FMI platform folder under `binaries/`.
+#[cfg(target_os = "macos")]
+pub const PLATFORM: &str = "darwin64";
+/// FMI platform folder under `binaries/`.
+#[cfg(target_os = "windows")]
+pub const PLATFORM: &str = "win64";
+/// FMI platform folder under `binaries/`.
+#[cfg(not(any(target_os = "macos", target_os = "windows")))]
+pub const PLATFORM: &str = "linux64";
+
+/// Extension of a shared library on this platform (`so`, `dylib`, `dll`).
+pub const LIB_EXT: &str = std::env::consts::DLL_EXTENSION;
+
+/// What packing can fail with.
+#[derive(Debug, thiserror::Error)]
+pub enum PackError {
+    /// The model file does not load (bad input).
+    #[error("{0}")]
+    Model(#[from] ModelError),
+    /// The FMU's shared library was not found.
+    #[error("{0}")]
+    LibraryNotFound(String),
+    /// Reading or writing a file failed.
+    #[error("{context}: {source}")]
+    Io {
+        /// What was being read or written.
+        context: String,
+        source: std::io::Error,
+    },
+}
+
+fn io_err(context: impl Into<String>) -> impl FnOnce(std::io::Error) -> PackError {
+    let context = context.into();
+    move |source| PackError::Io { context, source }
+}
+
+/// What was packed.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Packed {
+    /// The FMU's modelIdentifier (also the shared library's base name).
+    pub model_identifier: String,
+    /// The FMU's GUID.
+    pub guid: String,
+}
+
+/// The files of an FMU, relative path and contents, in archive order.
+struct Contents {
+    packed: Packed,
+    files: Vec<(String, Vec<u8>)>,
+}
+
+/// Name of this crate's cdylib as cargo writes it (`libmbfmu.so` on Linux).
+pub fn library_file_name() -> String {
+    format!("{}mbfmu{}", std::env::consts::DLL_PREFIX, std::env::consts::DLL_SUFFIX)
+}
+
+/// Locate the cdylib to embed: `MBFMU_LIB`, else the newest of `libmbfmu.so` next to the
+/// running executable, in its `deps/` subdirectory, or in its parent directory. (`cargo
+/// build` puts the cdylib next to the binary; `cargo test` only updates `deps/`, and runs
+/// test executables from `deps/`.)
+pub fn find_library() -> Result<PathBuf, PackError> {
+    if let Some(p) = std::env::var_os("MBFMU_LIB") {
+        let p = PathBuf::from(p);
+        return if p.is_file() {
+            Ok(p)
+        } else {
+            Err(PackError::LibraryNotFound(format!("MBFMU_LIB={} is not a file", p.display())))
+        };
+    }
+    let name = library_file_name();
+    let exe = std::env::current_exe().map_err(io_err("locating the running executable"))?;
+    let dir = exe.parent().unwrap_or(Path::new("."));
+    let mut candidates = vec![dir.join(&name), dir.join("deps").join(&name)];
+    if let Some(parent) = dir.parent() {
+        candidates.push(parent.join(&name));
+    }
+    let newest = candidates
+        .iter()
+        .filter_map(|p| {
+            let meta = std::fs::metadata(p).ok().filter(|m| m.is_file())?;
+            Some((meta.modified().ok(), p))
+        })
+        .max_by_key(|(modified, _)| *modified);
+    match newest {
+        Some((_, p)) => Ok(p.clone()),
+        None => Err(PackError::LibraryNotFound(format!(
+            "the FMU library {name} was not found (tried {}); build it with `cargo build --release` or set MBFMU_LIB",
+            candidates.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ")
+        ))),
+    }
+}
+
+/// Load the model and gather every file of its FMU.
+fn contents(model_path: &Path) -> Result<Contents, PackError> {
+    let label = model_path.display().to_string();
+    let bytes = std::fs::read(model_path).map_err(|e| ModelError {
+        file: label.clone(),
+        pos: crate::model::SrcPos { line: 1, col: 1 },
+        element: "file".into(),
+        name: label.clone(),
+        msg: format!("cannot read: {e}"),
+    })?;
+    let text = std::str::from_utf8(&bytes).map_err(|e| ModelError {
+        file: label.clone(),
+        pos: crate::model::SrcPos { line: 1, col: 1 },
+        element: "file".into(),
+        name: label.clone(),
+        msg: format!("not UTF-8: {e}"),
+    })?;
+    let model = load_str(text, &label)?;
+    let id = model_identifier(&model.name);
+    let lib_path = find_library()?;
+    let lib = std::fs::read(&lib_path).map_err(io_err(format!("reading {}", lib_path.display())))?;
+    let xml = model_description::write(&model, text);
+    let files = vec![
+        ("modelDescription.xml".to_string(), xml.into_bytes()),
+        (format!("binaries/{PLATFORM}/{id}.{LIB_EXT}"), lib),
+        ("resources/model.xml".to_string(), bytes.clone()),
+    ];
+    Ok(Contents { packed: Packed { guid: guid(text), model_identifier: id }, files })
+}
+
+/// Write the FMU of the model file `model_path` as the zip archive `out` (replacing it).
+pub fn pack_fmu(model_path: &Path, out: &Path) -> Result<Packed, PackError> {
+    let c = contents(model_path)?;
+    write_zip(&c, out)?;
+    Ok(c.packed)
+}
+
+/// Write the FMU of the model file `model_path` unzipped into the directory `dir`
+/// (created if needed; files of the same names are replaced).
+pub fn pack_dir(model_path: &Path, dir: &Path) -> Result<Packed, PackError> {
+    let c = contents(model_path)?;
+    write_dir(&c, dir)?;
+    Ok(c.packed)
+}
+
+/// Pack both ways at once (either may be `None`); the model is loaded once.
+pub fn pack(model_path: &Path, fmu: Option<&Path>, dir: Option<&Path>) -> Result<Packed, PackError> {
+    let c = contents(model_path)?;
+    if let Some(out) = fmu {
+        write_zip(&c, out)?;
+    }
+    if let Some(dir) = dir {
+        write_dir(&c, dir)?;
+    }
+    Ok(c.packed)
+}
+
+fn write_dir(c: &Contents, dir: &Path) -> Result<(), PackError> {
+    for (name, data) in &c.files {
+        let path = dir.join(name);
+        if let Some(parent) = path.parent() {
+            std::fs::create_dir_all(parent).map_err(io_err(format!("creating {}", parent.display())))?;
+        }
+        std::fs::write(&path, data).map_err(io_err(format!("writing {}", path.display())))?;
+    }
+    Ok(())
+}
+
+/// Write the archive to a sibling temporary file, then rename it over `out`, so that a
+/// failure never leaves a truncated FMU behind.
+fn write_zip(c: &Contents, out: &Path) -> Result<(), PackError> {
+    let mut tmp_name = out.file_name().map(|n| n.to_os_string()).unwrap_or_default();
+    tmp_name.push(".partial");
+    let tmp = out.with_file_name(tmp_name);
+    let result = write_zip_to(c, &tmp, out);
+    match result {
+        Ok(()) => std::fs::rename(&tmp, out).map_err(io_err(format!("writing {}", out.display()))),
+        Err(e) => {
+            let _ = std::fs::remove_file(&tmp);
+            Err(e)
+        }
+    }
+}
+
+fn write_zip_to(c: &Contents, tmp: &Path, out: &Path) -> Result<(), PackError> {
+    let ctx = || format!("writing {}", out.display());
+    let file = std::fs::File::create(tmp).map_err(io_err(ctx()))?;
+    let mut zip = zip::ZipWriter::new(std::io::BufWriter::new(file));
+    for (name, data) in &c.files {
+        let mode = if name.starts_with("binaries/") { 0o755 } else { 0o644 };
+        let options = SimpleFileOptions::default()
+            .compression_method(CompressionMethod::Deflated)
+            .unix_permissions(mode)
+            .large_file(data.len() >= u32::MAX as usize);
+        zip.start_file(name.as_str(), options).map_err(|e| PackError::Io { context: ctx(), source: e.into() })?;
+        zip.write_all(data).map_err(io_err(ctx()))?;
+    }
+    let mut w = zip.finish().map_err(|e| PackError::Io { context: ctx(), source: e.into() })?;
+    w.flush().map_err(io_err(ctx()))?;
+    Ok(())
+}

@@ -1,0 +1,109 @@
+//! The modelDescription.xml of every example model equals its golden file in
+//! `modelDescription/`, except the `guid` and `generationTool` attributes (they carry the
+//! engine fingerprint, which changes with every source edit).
+//!
+//! After an intended change, regenerate the golden files with
+//! `MBFMU_BLESS=1 cargo test --release --test model_description` and review the diff.
+
+use std::path::{Path, PathBuf};
+
+use mbfmu::fmi::model_description::write;
+use mbfmu::model::load_file;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Every `models/*.xml`, sorted.
+fn models() -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(root().join("models"))
+        .expect("models/ exists")
+        .map(|e| e.expect("readable models/ entry").path())
+        .filter(|p| p.extension().is_some_and(|x| x == "xml"))
+        .collect();
+    v.sort();
+    v
+}
+
+/// Replace the value of attribute `name` (every occurrence) by `*`.
+fn blank_attr(xml: &str, name: &str) -> String {
+    let key = format!(" {name}=\"");
+    let mut out = String::with_capacity(xml.len());
+    let mut rest = xml;
+    // Attributes are written one per line in the root tag: also match a line start.
+    let key_nl = format!("\n  {name}=\"");
+    loop {
+        let hit = [rest.find(&key), rest.find(&key_nl)].into_iter().flatten().min();
+        let Some(i) = hit else { break };
+        let start = i + rest[i..].find('"').expect("the key ends with a quote") + 1;
+        let Some(len) = rest[start..].find('"') else { break };
+        out.push_str(&rest[..start]);
+        out.push('*');
+        rest = &rest[start + len..];
+    }
+    out.push_str(rest);
+    out
+}
+
+fn normalize(xml: &str) -> String {
+    blank_attr(&blank_attr(xml, "guid"), "generationTool")
+}
+
+fn generate(path: &Path) -> String {
+    let text = std::fs::read_to_string(path).expect("model readable");
+    let model = load_file(path).unwrap_or_else(|e| panic!("{e}"));
+    write(&model, &text)
+}
+
+#[test]
+fn model_descriptions_match_the_golden_files() {
+    let bless = std::env::var_os("MBFMU_BLESS").is_some_and(|v| v == "1");
+    let mut failures = Vec::new();
+    let models = models();
+    assert!(models.len() >= 7, "example models found: {}", models.len());
+    for path in models {
+        let stem = path.file_stem().expect("file name").to_string_lossy().into_owned();
+        let golden = root().join("modelDescription").join(format!("{stem}.xml"));
+        let actual = generate(&path);
+        if bless {
+            std::fs::create_dir_all(golden.parent().expect("parent")).expect("create modelDescription/");
+            std::fs::write(&golden, &actual).expect("write golden file");
+            continue;
+        }
+        let expected = std::fs::read_to_string(&golden).unwrap_or_default();
+        let (a, e) = (normalize(&actual), normalize(&expected));
+        if a != e {
+            let line =
+                a.lines().zip(e.lines()).position(|(x, y)| x != y).unwrap_or(a.lines().count().min(e.lines().count()));
+            failures.push(format!(
+                "{}: differs from the golden file at line {}:\n  generated: {}\n  golden:    {}",
+                golden.display(),
+                line + 1,
+                a.lines().nth(line).unwrap_or("<end of file>"),
+                e.lines().nth(line).unwrap_or("<end of file>")
+            ));
+        }
+    }
+    assert!(
+        failures.is_empty(),
+        "{}\n\nIf the change is intended, regenerate the golden files with\n  \
+         MBFMU_BLESS=1 cargo test --release --test model_description\nand review `git diff modelDescription/`.",
+        failures.join("\n")
+    );
+}
+
+#[test]
+fn normalization_blanks_only_guid_and_generation_tool() {
+    let xml = "<a\n  guid=\"{1}\"\n  generationTool=\"mbfmu 0.1.0+ab\"\n  modelName=\"guid\"/>\n<b guid=\"x\"/>";
+    assert_eq!(normalize(xml), "<a\n  guid=\"*\"\n  generationTool=\"*\"\n  modelName=\"guid\"/>\n<b guid=\"*\"/>");
+}
+
+#[test]
+fn the_guid_and_identifier_are_those_of_the_fmi_module() {
+    let path = root().join("models/pendulum.xml");
+    let text = std::fs::read_to_string(&path).expect("readable");
+    let xml = generate(&path);
+    assert!(xml.contains(&format!("  guid=\"{}\"\n", mbfmu::fmi::guid::guid(&text))));
+    assert!(xml.contains("modelIdentifier=\"pendulum\""));
+    assert!(xml.contains(&format!("generationTool=\"mbfmu {}\"", mbfmu::fmi::guid::ENGINE_VERSION)));
+}
