@@ -168,6 +168,12 @@ impl<T: Real, const N: usize> Real for Dual<T, N> {
     }
     fn sqrt(self) -> Self {
         let s = self.v.sqrt();
+        if s.val() == 0.0 {
+            // √ is not differentiable at 0; along directions where the argument does not
+            // change (e.g. |v|² at v = 0, so √ of it inside vm²) the derivative is 0.
+            let d = self.d.map(|x| if x.val() == 0.0 { T::zero() } else { x / (s + s) });
+            return Dual { v: s, d };
+        }
         self.chain(s, T::one() / (s + s))
     }
     fn powf(self, p: f64) -> Self {

@@ -7,6 +7,8 @@
 
 mod check;
 mod error;
+mod linearize;
+mod matrices;
 mod pack;
 mod run;
 mod simulate;
@@ -17,6 +19,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 pub use error::CliError;
+pub use linearize::LinearizeArgs;
 pub use pack::PackArgs;
 pub use simulate::{SimulateArgs, communication_points};
 
@@ -43,6 +46,9 @@ pub enum Command {
     /// Build the model's FMI 2.0 Co-Simulation FMU: a zip file (-o) and/or an unzipped
     /// directory (--out-dir).
     Pack(PackArgs),
+    /// Linearize a model at one or more times: chosen states, eigenvalue table, and A, B,
+    /// C, D as json, npz or mat.
+    Linearize(LinearizeArgs),
     /// Run the embedded default model (models/double_pendulum.xml) for 2 s and print a
     /// table of its outputs.
     Run,
@@ -88,6 +94,7 @@ pub fn execute(command: &Command) -> Result<(), CliError> {
         Command::Check { model } => check::check(model, &mut out),
         Command::Simulate(args) => simulate::simulate(args, &mut out),
         Command::Pack(args) => pack::run(args, &mut out),
+        Command::Linearize(args) => linearize::run(args, &mut out),
         Command::Run => run::run(&mut out),
     }
 }

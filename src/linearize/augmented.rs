@@ -87,6 +87,55 @@ impl Blocks {
     }
 }
 
+/// The smallest pivot of [C_q; s_q] relative to the largest, below which the states no
+/// longer parameterize the positions (Eq. 34e–f not solvable for q).
+const PARTITION_TOL: f64 = 1e-8;
+
+/// Check that the states still parameterize the motion here (the determinant condition
+/// after Eq. 36): full-pivot LU of the square [C_q; s_q].
+fn check_partition(
+    sys: &crate::mechanics::System,
+    sel: &Selection,
+    q: &[f64],
+    t: f64,
+    inputs: &[f64],
+) -> Result<(), EngineError> {
+    let n = sys.n();
+    let zeros = vec![0.0; n];
+    let mut j = Mat::<f64>::zeros(n, n);
+    for el in &sys.constraints {
+        for (e, jet) in jets(sys, el, q, &zeros, &zeros, t, inputs).iter().enumerate() {
+            for (a, &b) in el.bodies.iter().enumerate() {
+                for c in 0..NQ {
+                    j[(el.row + e, NQ * b + c)] = jet.dg[NQ * a + c];
+                }
+            }
+        }
+    }
+    for (k, st) in sel.states.iter().enumerate() {
+        let jet = &jets(sys, st, q, &zeros, &zeros, t, inputs)[0];
+        for (a, &b) in st.bodies().iter().enumerate() {
+            for c in 0..NQ {
+                j[(sys.m + k, NQ * b + c)] = jet.dg[NQ * a + c];
+            }
+        }
+    }
+    let lu = j.full_piv_lu();
+    let u = lu.U();
+    let piv: Vec<f64> = (0..n).map(|i| u[(i, i)].abs()).collect();
+    let big = piv.iter().copied().fold(0.0, f64::max);
+    let small = piv.iter().copied().fold(f64::INFINITY, f64::min);
+    if small.is_nan() || small <= PARTITION_TOL * big {
+        return Err(EngineError::Numeric(format!(
+            "at t = {t}: the linearization states ({}) no longer parameterize the motion (singular partition, \
+             pivot ratio {:.1e}); choose user states (<linearization>) that stay independent",
+            sel.states.iter().map(|s| s.name.as_str()).collect::<Vec<_>>().join(", "),
+            small / big
+        )));
+    }
+    Ok(())
+}
+
 /// Linearize the simulation at its current point in the states of `sel` (Eq. 34, 36).
 pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result<Linearization, EngineError> {
     let (udot, lam) = sim.accelerations()?;
@@ -101,6 +150,7 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
             sel.rank
         )));
     }
+    check_partition(sys, sel, &q, t, &inputs)?;
     let bl = Blocks { n, m, s };
     let mut k = Triplets::new();
     // Eq. 34a, 34b, 34d, 34e from the integrator's exact Jacobian of
@@ -237,7 +287,7 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
         }
         if (0..2 * s).any(|col| !c[(o, col)].is_finite()) || (0..ni).any(|v| !d[(o, v)].is_finite()) {
             return Err(EngineError::Numeric(format!(
-                "output '{}' cannot be linearized (element loads are not differentiated yet)",
+                "output '{}' has no finite derivative here (e.g. |v| at v = 0, or element loads, which are not differentiated yet)",
                 sys.output_names[o]
             )));
         }

@@ -30,7 +30,8 @@ pub fn eigen_table(a: &Mat<f64>) -> Result<Vec<EigenRow>, String> {
         .map(|z| {
             let im = if z.im.abs() <= 1e-12 * scale { 0.0 } else { z.im };
             let f = z.re.hypot(im);
-            EigenRow { frequency: f, damping: if f > 0.0 { -z.re / f } else { f64::NAN }, re: z.re, im }
+            // + 0.0 turns a −0 into +0 for printing.
+            EigenRow { frequency: f, damping: if f > 0.0 { -z.re / f + 0.0 } else { f64::NAN }, re: z.re + 0.0, im }
         })
         .collect();
     rows.sort_by(|x, y| (x.im != 0.0).cmp(&(y.im != 0.0)).then(x.frequency.total_cmp(&y.frequency)));

@@ -48,6 +48,9 @@ pub fn select_states(sys: &System, q: &[f64], t: f64, inputs: &[f64]) -> Result<
     let zeros = vec![0.0; n];
     for (k, s) in users.iter().enumerate() {
         let g = &jets(sys, s, q, &zeros, &zeros, t, inputs)[0];
+        if !g.g.is_finite() || g.dg.iter().any(|v| !v.is_finite()) {
+            return Err(format!("linearization state '{}' has no finite value or derivative here", s.name));
+        }
         for (a, &b) in s.bodies().iter().enumerate() {
             for c in 0..NQ {
                 j[(m + k, NQ * b + c)] = -USER_ROW_WEIGHT * g.dg[NQ * a + c];

@@ -1,0 +1,134 @@
+//! `mbfmu linearize`: simulate to each requested time, linearize there in the states
+//! selected at the start (as an FMU would), print the chosen states and the eigenvalue
+//! table, and optionally write A, B, C, D (JSON, NumPy .npz, or MATLAB v4 .mat).
+
+use std::io::Write;
+use std::path::PathBuf;
+
+use clap::Args;
+
+use super::CliError;
+use crate::dae::{SimOptions, Simulator};
+use crate::linearize::eigen::{eigen_table, format_table};
+use crate::linearize::{Linearization, Selection, linearize, select_states};
+use crate::model::parse::load_file;
+
+/// Arguments of `mbfmu linearize`.
+#[derive(Debug, Args)]
+pub struct LinearizeArgs {
+    /// Model file.
+    pub model: PathBuf,
+    /// Comma-separated operating times (default: the experiment's start, else 0).
+    #[arg(long, value_delimiter = ',')]
+    pub at: Vec<f64>,
+    /// Output format of the matrices: table (eigenvalues only), json, npz or mat.
+    #[arg(long, default_value = "table")]
+    pub format: String,
+    /// Where to write json/npz/mat (default: json to stdout; npz/mat need it).
+    #[arg(long, short)]
+    pub out: Option<PathBuf>,
+    /// Integration tolerance (default: the experiment's, else 1e-8).
+    #[arg(long)]
+    pub tol: Option<f64>,
+    /// Threads for the right-hand sides of the augmented system.
+    #[arg(long, default_value_t = 2)]
+    pub threads: usize,
+}
+
+/// Run the command.
+pub fn run(args: &LinearizeArgs, out: &mut dyn Write) -> Result<(), CliError> {
+    let model = load_file(&args.model)?;
+    if model.static_analysis {
+        return Err(CliError::Usage("static equilibrium (<analysis static=\"true\"/>) is not implemented yet".into()));
+    }
+    let t0 = model.experiment.start.unwrap_or(0.0);
+    let tol = args.tol.or(model.experiment.tolerance).unwrap_or(1e-8);
+    if tol.is_nan() || tol <= 0.0 {
+        return Err(CliError::Usage(format!("--tol must be positive, got {tol}")));
+    }
+    let mut times = if args.at.is_empty() { vec![t0] } else { args.at.clone() };
+    times.sort_by(f64::total_cmp);
+    if let Some(t) = times.iter().find(|t| !t.is_finite() || **t < t0) {
+        return Err(CliError::Usage(format!("--at {t}: times must be finite and not before the start {t0}")));
+    }
+    if !matches!(args.format.as_str(), "table" | "json" | "npz" | "mat") {
+        return Err(CliError::Usage(format!("--format {}: expected table, json, npz or mat", args.format)));
+    }
+    let mut sim = Simulator::new(&model, SimOptions { tol, max_step: None }, t0)?;
+    let sel = select_states(sim.system(), sim.q(), t0, &sim.inputs()).map_err(|e| CliError::Engine(e.into()))?;
+    let io_err = |e| CliError::io("writing output", e);
+    print_selection(&sel, out).map_err(io_err)?;
+    let mut results = Vec::new();
+    for &t in &times {
+        sim.advance(t)?;
+        let lin = linearize(&mut sim, &sel, args.threads)?;
+        let rows = eigen_table(&lin.a).map_err(|e| CliError::Engine(e.into()))?;
+        writeln!(out, "\nt = {t}: {} states, {} eigenvalues", lin.states.len(), lin.a.nrows()).map_err(io_err)?;
+        write!(out, "{}", format_table(&rows)).map_err(io_err)?;
+        results.push(lin);
+    }
+    match args.format.as_str() {
+        "json" => {
+            let text = to_json(&results);
+            match &args.out {
+                Some(p) => std::fs::write(p, text).map_err(|e| CliError::io(format!("writing {}", p.display()), e))?,
+                None => writeln!(out, "{text}").map_err(io_err)?,
+            }
+        }
+        f @ ("npz" | "mat") => {
+            let Some(p) = &args.out else { return Err(CliError::Usage(format!("--format {f} needs --out FILE"))) };
+            let bytes = if f == "npz" { super::matrices::npz(&results) } else { super::matrices::mat_v4(&results) };
+            std::fs::write(p, bytes?).map_err(|e| CliError::io(format!("writing {}", p.display()), e))?;
+        }
+        _ => {}
+    }
+    Ok(())
+}
+
+/// Print the selected states and any dropped user states.
+pub fn print_selection(sel: &Selection, out: &mut dyn Write) -> std::io::Result<()> {
+    let names: Vec<&str> = sel.states.iter().map(|s| s.name.as_str()).collect();
+    writeln!(out, "linearization states ({}): {}", names.len(), names.join(", "))?;
+    if !sel.dropped.is_empty() {
+        writeln!(out, "dropped user states (not independent of the others): {}", sel.dropped.join(", "))?;
+    }
+    Ok(())
+}
+
+fn json_matrix(m: &faer::Mat<f64>) -> String {
+    let rows: Vec<String> = (0..m.nrows())
+        .map(|i| format!("[{}]", (0..m.ncols()).map(|j| format!("{:e}", m[(i, j)])).collect::<Vec<_>>().join(", ")))
+        .collect();
+    format!("[{}]", rows.join(", "))
+}
+
+fn json_names(v: &[String]) -> String {
+    format!(
+        "[{}]",
+        v.iter()
+            .map(|s| format!("\"{}\"", s.replace('\\', "\\\\").replace('"', "\\\"")))
+            .collect::<Vec<_>>()
+            .join(", ")
+    )
+}
+
+/// The linearizations as a JSON array.
+pub fn to_json(results: &[Linearization]) -> String {
+    let items: Vec<String> = results
+        .iter()
+        .map(|l| {
+            format!(
+                "{{\"time\": {:e}, \"states\": {}, \"inputs\": {}, \"outputs\": {}, \"A\": {}, \"B\": {}, \"C\": {}, \"D\": {}}}",
+                l.time,
+                json_names(&l.states),
+                json_names(&l.inputs),
+                json_names(&l.outputs),
+                json_matrix(&l.a),
+                json_matrix(&l.b),
+                json_matrix(&l.c),
+                json_matrix(&l.d)
+            )
+        })
+        .collect();
+    format!("[{}]", items.join(",\n"))
+}

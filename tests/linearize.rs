@@ -1,0 +1,316 @@
+//! Exact linearization (Eq. 34) against analytic results and against central differences
+//! of the engine's own state-space equations (tests only).
+
+use faer::linalg::solvers::Solve;
+use mbfmu::dae::init::accelerations;
+use mbfmu::dae::sparse::SparseLu;
+use mbfmu::dae::{SimOptions, Simulator};
+use mbfmu::linearize::eigen::eigen_table;
+use mbfmu::linearize::jets::{PositionFn, jets};
+use mbfmu::linearize::outputs::output_gradient;
+use mbfmu::linearize::{linearize, select_states};
+use mbfmu::mechanics::System;
+use mbfmu::mechanics::body::NQ;
+use mbfmu::mechanics::kernels::constraint_first;
+use mbfmu::model::Model;
+use mbfmu::model::parse::{load_file, load_str};
+
+fn model(name: &str) -> Model {
+    load_file(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models").join(name)).unwrap()
+}
+
+/// Eigenvalue rows (frequency, damping, re, im) at time t.
+fn eig_at(m: &Model, t: f64) -> (Vec<String>, Vec<(f64, f64)>) {
+    let mut sim = Simulator::new(m, SimOptions { tol: 1e-10, max_step: None }, 0.0).unwrap();
+    let sel = select_states(sim.system(), sim.q(), 0.0, &sim.inputs()).unwrap();
+    sim.advance(t).unwrap();
+    let lin = linearize(&mut sim, &sel, 2).unwrap();
+    let rows = eigen_table(&lin.a).unwrap();
+    (sel.states.iter().map(|s| s.name.clone()).collect(), rows.iter().map(|r| (r.re, r.im)).collect())
+}
+
+fn with_states(xml: &str, states: &str) -> Model {
+    let start = xml.find("<linearization>").unwrap();
+    let end = xml.find("</linearization>").unwrap() + "</linearization>".len();
+    let text = format!("{}{}{}", &xml[..start], states, &xml[end..]);
+    let m = load_str(&text, "dp.xml").unwrap();
+    let mut p = m.param_values();
+    for (k, par) in m.parameters.iter().enumerate() {
+        if par.name == "th1" || par.name == "th2" {
+            p[k] = 0.0;
+        }
+    }
+    m.with_params(&p).unwrap()
+}
+
+#[test]
+fn double_pendulum_at_rest_has_the_analytic_frequencies_whichever_states() {
+    // Two uniform rods (m = L = 1) hanging at rest: det(K − ω²M) = 0 with
+    // M = mL²[[4/3, 1/2], [1/2, 1/3]], K = mgL[[3/2, 0], [0, 1/2]] gives
+    // ω² = (g/L)(3 ∓ 6/√7). At an equilibrium the eigenvalues do not depend on the
+    // coordinates: joint angles, tip x coordinates, or the engine's own choice all agree
+    // with the closed form to 1e-9 relative (exact linearization; round-off only).
+    let xml =
+        std::fs::read_to_string(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models/double_pendulum.xml"))
+            .unwrap();
+    let g = 9.80665f64;
+    let w = [(g * (3.0 - 6.0 / 7f64.sqrt())).sqrt(), (g * (3.0 + 6.0 / 7f64.sqrt())).sqrt()];
+    let choices = [
+        r#"<linearization><state name="a1" function="az(rod1.P, ground.O)"/><state name="a2" function="az(rod2.P, ground.O)"/></linearization>"#,
+        r#"<linearization><state name="x1" function="dx(rod1.A)"/><state name="x2" function="dx(rod2.tip)"/></linearization>"#,
+        "",
+    ];
+    for states in choices {
+        let (names, rows) = eig_at(&with_states(&xml, states), 0.0);
+        assert_eq!(rows.len(), 2, "{names:?} {rows:?}");
+        for (k, (re, im)) in rows.iter().enumerate() {
+            assert!(re.abs() < 1e-9 * w[k], "{names:?}: re {re}");
+            assert!((im - w[k]).abs() < 1e-9 * w[k], "{names:?}: {im} vs {}", w[k]);
+        }
+    }
+}
+
+#[test]
+fn damped_pendulum_has_the_analytic_natural_frequency_and_damping_ratio() {
+    // Compound pendulum (pivot 0.6 m from the CM) with a viscous joint damper c about its
+    // lower equilibrium: J_p θ'' + c θ' + m g d θ = 0, J_p = J_cm + m d²:
+    // ω_n = sqrt(m g d / J_p), ζ = c / (2 sqrt(J_p m g d)). 1e-9 relative.
+    let (m, jc, d, c, g) = (1.5f64, 0.08f64, 0.6f64, 0.4f64, 9.81f64);
+    let xml = format!(
+        r#"<multibody name="p" version="1">
+  <gravity value="0 0 -{g}"/>
+  <ground><marker name="O" position="0 0 0" z_axis="0 1 0"/></ground>
+  <body name="b" mass="{m}" inertia="0.05 {jc} 0.06" position="0 0 -{d}">
+    <marker name="P" position="0 0 {d}" z_axis="0 1 0"/>
+  </body>
+  <joint name="j" type="revolute" i="b.P" j="ground.O"/>
+  <spring_damper name="damper" type="rotational" i="b.P" j="ground.O" stiffness="0" damping="{c}"/>
+  <linearization><state name="tilt" function="az(b.P, ground.O)"/></linearization>
+</multibody>"#
+    );
+    let model = load_str(&xml, "p.xml").unwrap();
+    let (_, rows) = eig_at(&model, 0.0);
+    let jp = jc + m * d * d;
+    let wn = (m * g * d / jp).sqrt();
+    let zeta = c / (2.0 * (jp * m * g * d).sqrt());
+    assert_eq!(rows.len(), 1);
+    let (re, im) = rows[0];
+    let f = re.hypot(im);
+    assert!((f - wn).abs() < 1e-9 * wn, "{f} vs {wn}");
+    assert!((-re / f - zeta).abs() < 1e-9, "{} vs {zeta}", -re / f);
+}
+
+#[test]
+fn state_selection_completes_keeps_and_drops_user_states() {
+    let xml =
+        std::fs::read_to_string(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models/double_pendulum.xml"))
+            .unwrap();
+    let names = |states: &str| {
+        let m = with_states(&xml, states);
+        let sim = Simulator::new(&m, SimOptions::default(), 0.0).unwrap();
+        let sel = select_states(sim.system(), sim.q(), 0.0, &sim.inputs()).unwrap();
+        (sel.states.iter().map(|s| s.name.clone()).collect::<Vec<_>>(), sel.dropped)
+    };
+    // None: two internal coordinates.
+    let (s, d) = names("");
+    assert_eq!(s.len(), 2);
+    assert!(s.iter().all(|n| n.starts_with("rod")) && d.is_empty(), "{s:?}");
+    // Fewer than the dofs: the user's is kept, one internal added.
+    let (s, d) = names(r#"<linearization><state name="a2" function="az(rod2.P, ground.O)"/></linearization>"#);
+    assert_eq!(s[0], "a2");
+    assert_eq!(s.len(), 2);
+    assert!(d.is_empty());
+    // More than the dofs: one of three dropped and reported.
+    let (s, d) = names(
+        r#"<linearization><state name="a1" function="az(rod1.P, ground.O)"/><state name="a2" function="az(rod2.P, ground.O)"/><state name="x2" function="dx(rod2.tip)"/></linearization>"#,
+    );
+    assert_eq!(s.len(), 2, "{s:?}");
+    assert_eq!(d.len(), 1, "{d:?}");
+    // A state that cannot parameterize the motion (depends on time only) is dropped too.
+    let (s, d) = names(r#"<linearization><state name="clock" function="0*dx(rod1.A) + time"/></linearization>"#);
+    assert_eq!(d, ["clock"]);
+    assert_eq!(s.len(), 2);
+}
+
+#[test]
+fn singular_partition_is_reported_not_returned_as_a_matrix() {
+    // A free rotor (no gravity) turning at 1 rad/s about ground z, linearized in the y
+    // coordinate of its CM, y = L sin θ: fine at θ = 0, singular at θ = π/2 (dy/dθ = 0),
+    // reached at t = π/2 (uniform rotation, integrated to ~1e-10). There linearize must
+    // refuse with a message, never return a matrix.
+    let xml = r#"<multibody name="r" version="1">
+  <ground><marker name="O" position="0 0 0"/></ground>
+  <body name="b" mass="1" inertia="0.1 0.1 0.1" position="0.5 0 0" angular_velocity="0 0 1" velocity="0 0.5 0">
+    <marker name="P" position="-0.5 0 0"/>
+  </body>
+  <joint name="j" type="revolute" i="b.P" j="ground.O"/>
+  <linearization><state name="yc" function="dy(b.cm)"/></linearization>
+</multibody>"#;
+    let m = load_str(xml, "r.xml").unwrap();
+    let mut sim = Simulator::new(&m, SimOptions { tol: 1e-12, max_step: None }, 0.0).unwrap();
+    let sel = select_states(sim.system(), sim.q(), 0.0, &sim.inputs()).unwrap();
+    assert_eq!(sel.states[0].name, "yc");
+    assert!(linearize(&mut sim, &sel, 1).is_ok());
+    sim.advance(std::f64::consts::FRAC_PI_2).unwrap();
+    let err = linearize(&mut sim, &sel, 1).err().map(|e| e.to_string()).unwrap_or_default();
+    assert!(err.contains("no longer parameterize"), "{err}");
+}
+
+/// The engine's state-space map x = (S, W), v ↦ (Ṡ, Ẇ, y): q from C(q) = 0, s(q) = S by
+/// Newton; u from P u + C_t = 0, ṡ(q, u) = W; u̇ from the equations of motion.
+fn state_space(
+    sys: &System,
+    sel: &mbfmu::linearize::Selection,
+    q0: &[f64],
+    t: f64,
+    x: &[f64],
+    v: &[f64],
+) -> (Vec<f64>, Vec<f64>) {
+    let (n, m, s) = (sys.n(), sys.m, sel.states.len());
+    let zeros = vec![0.0; n];
+    let mut q = q0.to_vec();
+    let square = |q: &[f64], u: &[f64], level: usize| -> (Vec<f64>, Vec<f64>) {
+        // Rows: constraints (level 0: C, level 1: Ċ), then states (s or ṡ); columns: q or u.
+        let mut mat = vec![0.0; n * n];
+        let mut r = vec![0.0; n];
+        for el in &sys.constraints {
+            let js = jets(sys, el, q, u, &zeros, t, v);
+            for (e, j) in js.iter().enumerate() {
+                let row = el.row + e;
+                r[row] = if level == 0 { j.g } else { j.g1 };
+                let g = if level == 0 { &j.dg } else { &j.dg1 };
+                let nql = NQ * el.bodies().len();
+                for a in 0..nql {
+                    mat[row * n + NQ * el.bodies()[a / NQ] + a % NQ] += g[if level == 0 { a } else { nql + a }];
+                }
+            }
+        }
+        for (k, st) in sel.states.iter().enumerate() {
+            let j = &jets(sys, st, q, u, &zeros, t, v)[0];
+            r[m + k] = if level == 0 { j.g - x[k] } else { j.g1 - x[s + k] };
+            let g = if level == 0 { &j.dg } else { &j.dg1 };
+            let nql = NQ * st.bodies().len();
+            for a in 0..nql {
+                mat[(m + k) * n + NQ * st.bodies()[a / NQ] + a % NQ] += g[if level == 0 { a } else { nql + a }];
+            }
+        }
+        (mat, r)
+    };
+    let solve = |mat: &[f64], r: &[f64]| -> Vec<f64> {
+        let a = faer::Mat::from_fn(n, n, |i, j| mat[i * n + j]);
+        let b = faer::Mat::from_fn(n, 1, |i, _| r[i]);
+        let sol = a.full_piv_lu().solve(&b);
+        (0..n).map(|i| sol[(i, 0)]).collect()
+    };
+    for _ in 0..30 {
+        let (mat, r) = square(&q, &zeros, 0);
+        let dq = solve(&mat, &r);
+        for i in 0..n {
+            q[i] -= dq[i];
+        }
+        if dq.iter().all(|d| d.abs() < 1e-15) {
+            break;
+        }
+    }
+    // ṡ and Ċ are affine in u: residual at u = 0, matrix = their u-gradients.
+    let (mat, r) = square(&q, &zeros, 1);
+    let u: Vec<f64> = solve(&mat, &r).iter().map(|x| -x).collect();
+    let (udot, _) = accelerations(sys, &q, &u, t, v, &mut SparseLu::new()).unwrap();
+    let mut xd = x[s..].to_vec();
+    for st in &sel.states {
+        xd.push(jets(sys, st, &q, &u, &udot, t, v)[0].g2);
+    }
+    let y = (0..sys.outputs.len())
+        .map(|o| {
+            let _ = output_gradient;
+            let ids: Vec<usize> = (0..sys.nb()).collect();
+            let ctx = mbfmu::mechanics::local::LocalCtx::new(sys, &ids, &q, &u, &udot, t, v);
+            ctx.eval_expr(&sys.outputs[o], sys.output_bases[o])
+        })
+        .collect();
+    let _ = constraint_first;
+    (xd, y)
+}
+
+const ARM: &str = r#"<multibody name="arm" version="1">
+  <gravity value="0 0 -9.81"/>
+  <ground><marker name="O" position="0 0 0" z_axis="0 0 1"/></ground>
+  <body name="l1" mass="2" inertia="0.02 0.02 0.01" position="0 0 0.25">
+    <marker name="base" position="0 0 -0.25" z_axis="0 0 1"/>
+    <marker name="top" position="0 0 0.25" z_axis="0 1 0"/>
+  </body>
+  <body name="l2" mass="1.5" inertia="0.04 0.01 0.04" position="0 0.2 0.5" euler313="0.1 0.2 0.3">
+    <marker name="a" position="0 -0.2 0" z_axis="0 1 0"/>
+    <marker name="b" position="0 0.2 0" z_axis="1 0 0"/>
+  </body>
+  <body name="l3" mass="1" inertia="0.02 0.01 0.02" position="0 0.55 0.5">
+    <marker name="a" position="0 -0.15 0" z_axis="1 0 0"/>
+    <marker name="tip" position="0 0.15 0"/>
+  </body>
+  <joint name="j1" type="revolute" i="l1.base" j="ground.O"/>
+  <joint name="j2" type="revolute" i="l2.a" j="l1.top"/>
+  <joint name="j3" type="revolute" i="l3.a" j="l2.b"/>
+  <input name="T1" start="0.5"/>
+  <input name="T2" start="-0.3"/>
+  <input name="T3" start="0.2"/>
+  <sforce name="m1" type="rotational" i="l1.base" j="ground.O" function="T1 - 0.1*wz(l1.base, ground.O, ground.O)"/>
+  <sforce name="m2" type="rotational" i="l2.a" j="l1.top" function="T2"/>
+  <sforce name="m3" type="rotational" i="l3.a" j="l2.b" function="T3 + 0.5*sin(az(l3.a, l2.b))"/>
+  <output name="tip_x" function="dx(l3.tip)"/>
+  <output name="tip_z" function="dz(l3.tip)"/>
+  <output name="tip_acc" function="accy(l3.tip) + 0.1*T1"/>
+</multibody>"#;
+
+#[test]
+fn spatial_arm_abcd_match_central_differences_of_the_state_space_equations() {
+    // At a non-equilibrium point (after 0.3 s of motion, internal states chosen by Eq. 33),
+    // A, B, C, D from Eq. 34 against central differences of the engine's own state-space
+    // map (solve q, u from the states, u̇ from the equations of motion). h = 1e-6:
+    // truncation ~1e-12·|f'''|, round-off ~1e-16/1e-6 · |f| ≈ 1e-9 relative, so 1e-6
+    // (relative to max(1, |entry|)) is a safe bound that still catches any wrong term.
+    let m = load_str(ARM, "arm.xml").unwrap();
+    let mut sim = Simulator::new(&m, SimOptions { tol: 1e-10, max_step: None }, 0.0).unwrap();
+    let sel = select_states(sim.system(), sim.q(), 0.0, &sim.inputs()).unwrap();
+    assert_eq!(sel.states.len(), 3);
+    sim.advance(0.3).unwrap();
+    let lin = linearize(&mut sim, &sel, 2).unwrap();
+    let (sys, q0, t, v0) = (sim.system().clone(), sim.q().to_vec(), sim.time(), sim.inputs());
+    let x0 = lin.x.clone();
+    let ns = x0.len();
+    let h = 1e-6;
+    let check = |name: &str, got: f64, want: f64| {
+        assert!((got - want).abs() < 1e-6 * want.abs().max(1.0), "{name}: {got} vs {want}");
+    };
+    for j in 0..ns {
+        let (mut xp, mut xm) = (x0.clone(), x0.clone());
+        xp[j] += h;
+        xm[j] -= h;
+        let (fp, yp) = state_space(&sys, &sel, &q0, t, &xp, &v0);
+        let (fm, ym) = state_space(&sys, &sel, &q0, t, &xm, &v0);
+        for i in 0..ns {
+            check(&format!("A[{i},{j}]"), lin.a[(i, j)], (fp[i] - fm[i]) / (2.0 * h));
+        }
+        for o in 0..yp.len() {
+            check(&format!("C[{o},{j}]"), lin.c[(o, j)], (yp[o] - ym[o]) / (2.0 * h));
+        }
+    }
+    for k in 0..v0.len() {
+        let (mut vp, mut vm) = (v0.clone(), v0.clone());
+        vp[k] += h;
+        vm[k] -= h;
+        let (fp, yp) = state_space(&sys, &sel, &q0, t, &x0, &vp);
+        let (fm, ym) = state_space(&sys, &sel, &q0, t, &x0, &vm);
+        for i in 0..ns {
+            check(&format!("B[{i},{k}]"), lin.b[(i, k)], (fp[i] - fm[i]) / (2.0 * h));
+        }
+        for o in 0..yp.len() {
+            check(&format!("D[{o},{k}]"), lin.d[(o, k)], (yp[o] - ym[o]) / (2.0 * h));
+        }
+    }
+    // The acceleration output feels the torques directly: D has nonzero entries.
+    assert!(
+        (0..3).any(|k| lin.d[(2, k)].abs() > 1e-3),
+        "D row of tip_acc: {:?}",
+        (0..3).map(|k| lin.d[(2, k)]).collect::<Vec<_>>()
+    );
+}
