@@ -13,11 +13,7 @@ use mbfmu::mechanics::System;
 use mbfmu::mechanics::body::NQ;
 use mbfmu::mechanics::kernels::constraint_first;
 use mbfmu::model::Model;
-use mbfmu::model::parse::{load_file, load_str};
-
-fn model(name: &str) -> Model {
-    load_file(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models").join(name)).unwrap()
-}
+use mbfmu::model::parse::load_str;
 
 /// Eigenvalue rows (frequency, damping, re, im) at time t.
 fn eig_at(m: &Model, t: f64) -> (Vec<String>, Vec<(f64, f64)>) {
