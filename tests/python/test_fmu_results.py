@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from fmpy import simulate_fmu
 
-from fmu_helpers import initialize, new_slave, simulate_cli, steps
+from fmu_helpers import initialize, new_slave, run_mbfmu, simulate_cli, steps
 
 TOL = 1e-8  # integration tolerance of both runs (tighter than every model's default)
 END = 1.0
@@ -46,6 +46,20 @@ def test_a_different_tolerance_is_visible_at_that_bound(packed, tmp_path):
     _, tight = simulate_cli(p.model, tmp_path / "a.csv", END, STEP, TOL)
     _, loose = simulate_cli(p.model, tmp_path / "b.csv", END, STEP, 1e-6)
     assert np.max(np.abs(np.array(tight) - np.array(loose))) > 1e-8
+
+
+def test_without_a_tolerance_both_use_the_models_default_experiment(packed, tmp_path):
+    """fmpy without relative_tolerance takes the tolerance of <DefaultExperiment>; the CLI
+    without --tol takes the model's <experiment tolerance>: the same number (1e-6 here)."""
+    p = packed("double_pendulum")
+    assert float(p.md.defaultExperiment.tolerance) == 1e-6
+    r = run_mbfmu("simulate", str(p.model), "--end", "0.5", "--step", "0.05", "--out", str(tmp_path / "d.csv"))
+    assert r.returncode == 0, r.stderr
+    cli = np.loadtxt(tmp_path / "d.csv", delimiter=",", skiprows=1)
+    res = simulate_fmu(str(p.fmu), output_interval=0.05, stop_time=0.5, output=p.outputs)
+    # 1e-9: as in the first test.
+    for k, out in enumerate(p.outputs, start=1):
+        np.testing.assert_allclose(res[out], cli[:, k], rtol=1e-9, atol=1e-9, err_msg=out)
 
 
 # Bound on the difference between the runs with communication steps 0.001 and 0.25 at
