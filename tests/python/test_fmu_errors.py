@@ -103,3 +103,36 @@ def test_setting_an_output_is_refused_in_every_state(logged):
     s.setReal([vr["T"]], [2.0])
     s.doStep(0.0, 0.1)
     assert s.getReal([out])[0] == pytest.approx(2.0 * 0.1 / J, abs=1e-10)
+
+
+def test_step_from_a_wrong_time_or_past_stop_time_is_refused(logged):
+    s, log, vr = logged
+    initialize(s, 1e-8, stop=1.0, values={vr["T"]: 1.0})
+    refused(lambda: s.doStep(0.1, 0.1), "fmi2DoStep", log, "currentCommunicationPoint 0.1", "current time 0")
+    refused(lambda: s.doStep(0.0, 2.0), "fmi2DoStep", log, "beyond stopTime 1")
+    refused(lambda: s.doStep(0.0, -0.1), "fmi2DoStep", log, "-0.1")
+    s.doStep(0.0, 1.0)
+    assert s.getReal([vr["w"]])[0] == pytest.approx(1.0 / J, abs=1e-10)
+
+
+def test_a_state_of_another_fmu_or_garbage_is_refused(logged, packed):
+    s, log, vr = logged
+    initialize(s, 1e-8)
+    other = new_slave(packed("pendulum"), "other")
+    try:
+        initialize(other, 1e-8)
+        st = other.getFMUstate()
+        foreign = other.serializeFMUstate(st)
+        other.freeFMUstate(st)
+    finally:
+        other.terminate()
+        other.freeInstance()
+    refused(lambda: s.deSerializeFMUstate(foreign), "fmi2DeSerializeFMUstate", log, "belongs to FMU",
+            packed("pendulum").md.guid)
+    refused(lambda: s.deSerializeFMUstate(b"garbage"), "fmi2DeSerializeFMUstate", log, "not a serialized state")
+    own = s.getFMUstate()
+    restored = s.deSerializeFMUstate(s.serializeFMUstate(own))
+    s.setFMUstate(restored)
+    s.freeFMUstate(own)
+    s.freeFMUstate(restored)
+    s.doStep(0.0, 0.1)

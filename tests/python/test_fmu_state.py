@@ -64,3 +64,41 @@ def test_serialized_state_continues_in_a_new_instance_bit_for_bit(name, packed):
         if b is not None:
             b.terminate()
             b.freeInstance()
+
+
+def test_a_restored_state_brings_back_the_input_and_its_slope(rotor):
+    vr = rotor.vr
+    s = new_slave(rotor, "inputs")
+    b = None
+    try:
+        initialize(s, TOL)
+        s.setReal([vr["T"]], [2.0])
+        s.setRealInputDerivatives([vr["T"]], [1], [3.0])  # T(t) = 2 + 3 t
+        s.doStep(0.0, 0.5)
+        state = s.getFMUstate()
+        data = s.serializeFMUstate(state)
+        s.doStep(0.5, 0.5)
+        first = s.getReal([vr["w"], vr["T"]])
+        # J w(1) = 2 + 3/2 and T(1) = 5; 1e-10 as in test_fmu_inputs (exact polynomial).
+        assert first[0] == pytest.approx(3.5 / 0.5, abs=1e-10) and first[1] == pytest.approx(5.0, abs=1e-12)
+
+        s.setFMUstate(state)
+        s.setReal([vr["T"]], [-7.0])  # a new constant input, then back to the saved state
+        s.setFMUstate(state)
+        s.doStep(0.5, 0.5)
+        assert s.getReal([vr["w"], vr["T"]]) == first  # exact: the state includes both
+        s.freeFMUstate(state)
+
+        b = new_slave(rotor, "inputs2")
+        initialize(b, TOL)  # T = 0, no slope
+        restored = b.deSerializeFMUstate(data)
+        b.setFMUstate(restored)
+        b.freeFMUstate(restored)
+        b.doStep(0.5, 0.5)
+        assert b.getReal([vr["w"], vr["T"]]) == first
+    finally:
+        s.terminate()
+        s.freeInstance()
+        if b is not None:
+            b.terminate()
+            b.freeInstance()
