@@ -206,13 +206,17 @@ fn simulated_spring_mass_damper_csv_matches_the_closed_form() {
 }
 
 #[test]
-fn run_prints_a_table_of_the_default_model() {
+fn run_prints_the_eigenvalue_table_and_a_table_of_the_default_model() {
     let o = mbfmu(&["run"]);
     assert!(o.status.success(), "{}", stderr(&o));
     let text = stdout(&o);
     assert!(text.contains("theta1") && text.contains("theta2"), "{text}");
-    // title, header, 21 rows (t = 0, 0.1, ..., 2).
-    assert_eq!(text.lines().count(), 23, "{text}");
+    // Eigenvalue table: the hanging double pendulum's ω² = (g/L)(3 ∓ 6/√7), printed with
+    // 7 digits: 2.679656 and 7.187443 rad/s.
+    let eig: Vec<&str> = text.lines().skip(2).take(2).collect();
+    assert!(eig[0].contains("2.679656e0") && eig[1].contains("7.187443e0"), "{text}");
+    // Eigen title, header, 2 rows, blank line; title, header, 21 rows (t = 0, 0.1, ..., 2).
+    assert_eq!(text.lines().count(), 5 + 23, "{text}");
     let last: Vec<&str> = text.lines().last().unwrap().split_whitespace().collect();
     assert_eq!(last[0], "2.000");
 }

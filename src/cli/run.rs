@@ -1,12 +1,14 @@
-//! `mbfmu run`: the main job on the embedded default model. For now it simulates
-//! `models/double_pendulum.xml` for 2 s and prints a table of its outputs (later: the
-//! eigenvalue table).
+//! `mbfmu run`: the main job on the embedded default model `models/double_pendulum.xml`:
+//! the eigenvalue table of its linearization at rest (θ1 = θ2 = 0, states α1, α2), then a
+//! 2 s simulation from its release angles with a table of its outputs.
 
 use std::io::Write;
 
 use super::CliError;
 use super::simulate::{RunSettings, drive, header};
 use crate::dae::{SimOptions, Simulator};
+use crate::linearize::eigen::{eigen_table, format_table};
+use crate::linearize::{linearize, select_states};
 use crate::model::parse::load_str;
 
 /// Name under which the embedded model reports errors.
@@ -24,11 +26,27 @@ const WIDTH: usize = 14;
 /// Simulate the embedded default model and print an aligned table of time and outputs.
 pub fn run(out: &mut dyn Write) -> Result<(), CliError> {
     let model = load_str(DEFAULT_MODEL, DEFAULT_MODEL_FILE)?;
+    let io_err = |e| CliError::io("writing to stdout", e);
+    // Linearization at the hanging equilibrium: release angles set to 0.
+    let mut p = model.param_values();
+    for (k, par) in model.parameters.iter().enumerate() {
+        if par.name == "th1" || par.name == "th2" {
+            p[k] = 0.0;
+        }
+    }
+    let at_rest = model.with_params(&p).map_err(CliError::Usage)?;
+    let mut sim = Simulator::new(&at_rest, SimOptions { tol: 1e-10, max_step: None }, 0.0)?;
+    let sel = select_states(sim.system(), sim.q(), 0.0, &sim.inputs()).map_err(|e| CliError::Engine(e.into()))?;
+    let lin = linearize(&mut sim, &sel, 2)?;
+    let rows = eigen_table(&lin.a).map_err(|e| CliError::Engine(e.into()))?;
+    writeln!(out, "{DEFAULT_MODEL_FILE} at rest (th1 = th2 = 0), linearized in {}:", lin.states.join(", "))
+        .map_err(io_err)?;
+    write!(out, "{}", format_table(&rows)).map_err(io_err)?;
+    writeln!(out).map_err(io_err)?;
     let settings = RunSettings::resolve(&model, Some(RUN_END), Some(RUN_STEP), None)?;
     let points = settings.points()?;
     let opts = SimOptions { tol: settings.tol, max_step: None };
     let mut sim = Simulator::new(&model, opts, settings.start)?;
-    let io_err = |e| CliError::io("writing to stdout", e);
 
     writeln!(
         out,
