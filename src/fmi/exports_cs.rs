@@ -76,18 +76,31 @@ pub unsafe extern "C" fn fmi2GetRealOutputDerivatives(
     })
 }
 
-/// fmi2GetDirectionalDerivative (2.1.9 Getting Partial Derivatives): not provided yet.
+/// fmi2GetDirectionalDerivative (2.1.9 Getting Partial Derivatives): rows and columns of
+/// the exact linearization A, B, C, D (seed Eq. 34) at the current communication point.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2GetDirectionalDerivative(
     c: Component,
-    _vUnknown_ref: *const ValueReference,
-    _nUnknown: size_t,
-    _vKnown_ref: *const ValueReference,
-    _nKnown: size_t,
-    _dvKnown: *const Real,
-    _dvUnknown: *mut Real,
+    vUnknown_ref: *const ValueReference,
+    nUnknown: size_t,
+    vKnown_ref: *const ValueReference,
+    nKnown: size_t,
+    dvKnown: *const Real,
+    dvUnknown: *mut Real,
 ) -> Status {
-    guarded(c, Func::GetDirectionalDerivative, |_| Err("not provided yet".into()))
+    guarded(c, Func::GetDirectionalDerivative, |inst| {
+        // SAFETY: nUnknown / nKnown elements each, per FMI.
+        let (u, k, dv, out) = unsafe {
+            (
+                slice(vUnknown_ref, nUnknown, "vUnknown_ref")?,
+                slice(vKnown_ref, nKnown, "vKnown_ref")?,
+                slice(dvKnown, nKnown, "dvKnown")?,
+                slice_mut(dvUnknown, nUnknown, "dvUnknown")?,
+            )
+        };
+        inst.directional_derivative(u, k, dv, out)?;
+        Ok(Status::Ok)
+    })
 }
 
 /// fmi2GetStatus (4.2.3 Retrieving Status Information from the Slave): fmi2DoStepStatus

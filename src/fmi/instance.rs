@@ -6,7 +6,8 @@ use super::logger::Logger;
 use super::state_machine::State;
 use super::types::Status;
 use super::variables::{Target, Variable, variables};
-use crate::dae::{SimOptions, Simulator};
+use crate::dae::{SimOptions, SimState, Simulator};
+use crate::linearize::{Linearization, Selection, linearize, selection_by_name, state_values};
 use crate::model::Model;
 
 /// What the host chose: parameter and input values, input slopes, experiment.
@@ -25,6 +26,10 @@ pub struct Built {
     pub sim: Simulator,
     pub params: Vec<f64>,
     pub tol: f64,
+    /// The linearization states of modelDescription.xml, rebuilt on this engine's system.
+    pub sel: Result<Selection, String>,
+    /// The last linearization and the engine state it belongs to (cache).
+    pub lin: Option<(SimState, Linearization)>,
 }
 
 /// Outcome of fmi2DoStep once its arguments are valid.
@@ -137,7 +142,10 @@ impl Instance {
                 sim.set_input_derivative(k, s);
             }
         }
-        Ok(Built { sim, params: cfg.params.clone(), tol: cfg.tol })
+        let names: Vec<String> =
+            self.vars.iter().filter(|v| matches!(v.target, Target::State(_))).map(|v| v.name.clone()).collect();
+        let sel = selection_by_name(sim.system(), &names);
+        Ok(Built { sim, params: cfg.params.clone(), tol: cfg.tol, sel, lin: None })
     }
 
     /// fmi2GetReal: values of `vrs` into `out`.
@@ -145,6 +153,7 @@ impl Instance {
         let targets = vrs.iter().map(|&vr| Ok(self.var(vr)?.target)).collect::<Result<Vec<Target>, String>>()?;
         let mut outputs = None;
         let mut inputs = None;
+        let mut states: Option<[Vec<f64>; 3]> = None;
         for (t, o) in targets.iter().zip(out.iter_mut()) {
             *o = match *t {
                 Target::Parameter(k) => self.config.params[k],
@@ -158,6 +167,22 @@ impl Instance {
                         outputs = Some(sim.outputs().map_err(|e| format!("outputs cannot be evaluated: {e}"))?);
                     }
                     outputs.as_ref().expect("evaluated")[k]
+                }
+                Target::State(k) | Target::StateDerivative(k) | Target::StateSecondDerivative(k) => {
+                    if states.is_none() {
+                        self.simulator()?;
+                        let b = self.built.as_mut().expect("built");
+                        let sel = b.sel.as_ref().map_err(|e| e.clone())?;
+                        states = Some(
+                            state_values(&mut b.sim, sel).map_err(|e| format!("states cannot be evaluated: {e}"))?,
+                        );
+                    }
+                    let v = states.as_ref().expect("evaluated");
+                    match *t {
+                        Target::State(_) => v[0][k],
+                        Target::StateDerivative(_) => v[1][k],
+                        _ => v[2][k],
+                    }
                 }
             };
         }
@@ -179,6 +204,12 @@ impl Instance {
             }
             match var.target {
                 Target::Output(_) => return Err(format!("'{}' (vr {vr}) is an output and cannot be set", var.name)),
+                Target::State(_) | Target::StateDerivative(_) | Target::StateSecondDerivative(_) => {
+                    return Err(format!(
+                        "'{}' (vr {vr}) is a linearization state (computed from the motion) and cannot be set",
+                        var.name
+                    ));
+                }
                 Target::Parameter(_) if self.initialized() => {
                     return Err(format!(
                         "parameter '{}' (vr {vr}) cannot be set after initialization (state {:?})",
@@ -203,8 +234,81 @@ impl Instance {
                         self.dirty = true;
                     }
                 }
-                Target::Output(_) => unreachable!("refused above"),
+                _ => unreachable!("refused above"),
             }
+        }
+        Ok(())
+    }
+
+    /// The linearization at the current point, computed once per engine state (cached
+    /// until the state, an input or a parameter changes).
+    fn linearization(&mut self) -> Result<&Linearization, String> {
+        self.simulator()?;
+        let b = self.built.as_mut().expect("built");
+        let key = b.sim.snapshot();
+        if b.lin.as_ref().is_none_or(|(k, _)| *k != key) {
+            let sel = b.sel.as_ref().map_err(|e| format!("no linearization states: {e}"))?;
+            let lin = linearize(&mut b.sim, sel, 2).map_err(|e| e.to_string())?;
+            b.lin = Some((key, lin));
+        }
+        Ok(&b.lin.as_ref().expect("cached").1)
+    }
+
+    /// fmi2GetDirectionalDerivative: Δunknown = (∂unknown/∂known) Δknown with unknowns
+    /// state derivatives and outputs, knowns states and inputs (rows and columns of
+    /// A, B, C, D at the current point).
+    pub fn directional_derivative(
+        &mut self,
+        unknowns: &[u32],
+        knowns: &[u32],
+        dv: &[f64],
+        out: &mut [f64],
+    ) -> Result<(), String> {
+        let col = |t: Target, s: usize| match t {
+            Target::State(k) => Some(k),
+            Target::StateDerivative(k) => Some(s + k),
+            Target::Input(i) => Some(2 * s + i),
+            _ => None,
+        };
+        let row = |t: Target, s: usize| match t {
+            Target::StateDerivative(k) => Some((false, k)),
+            Target::StateSecondDerivative(k) => Some((false, s + k)),
+            Target::Output(o) => Some((true, o)),
+            _ => None,
+        };
+        let kt: Vec<(u32, Target)> =
+            knowns.iter().map(|&vr| Ok((vr, self.var(vr)?.target))).collect::<Result<_, String>>()?;
+        let ut: Vec<(u32, Target)> =
+            unknowns.iter().map(|&vr| Ok((vr, self.var(vr)?.target))).collect::<Result<_, String>>()?;
+        let names = |vr: u32| self.var(vr).map(|v| v.name.clone()).unwrap_or_default();
+        let s = self.vars.iter().filter(|v| matches!(v.target, Target::State(_))).count();
+        for &(vr, t) in &kt {
+            if col(t, s).is_none() {
+                return Err(format!("known '{}' (vr {vr}) is neither a state nor an input", names(vr)));
+            }
+        }
+        for &(vr, t) in &ut {
+            if row(t, s).is_none() {
+                return Err(format!("unknown '{}' (vr {vr}) is neither a state derivative nor an output", names(vr)));
+            }
+        }
+        if let Some(v) = dv.iter().find(|v| !v.is_finite()) {
+            return Err(format!("seed value {v} is not finite"));
+        }
+        let lin = self.linearization()?;
+        for (o, &(_, t)) in out.iter_mut().zip(&ut) {
+            let (is_output, r) = row(t, s).expect("checked");
+            let mut acc = 0.0;
+            for (&(_, k), &d) in kt.iter().zip(dv) {
+                let c = col(k, s).expect("checked");
+                acc += d * match (is_output, c < 2 * s) {
+                    (false, true) => lin.a[(r, c)],
+                    (false, false) => lin.b[(r, c - 2 * s)],
+                    (true, true) => lin.c[(r, c)],
+                    (true, false) => lin.d[(r, c - 2 * s)],
+                };
+            }
+            *o = acc;
         }
         Ok(())
     }

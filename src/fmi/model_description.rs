@@ -50,7 +50,7 @@ pub fn write(model: &Model, model_text: &str) -> String {
         x.push_str("  ");
         attr_line(&mut x, name, value);
     }
-    x.push_str("    providesDirectionalDerivative=\"false\"/>\n");
+    x.push_str("    providesDirectionalDerivative=\"true\"/>\n");
 
     write_units(&mut x, &vars);
     write_experiment(&mut x, model);
@@ -195,6 +195,7 @@ fn write_variable(x: &mut String, index: usize, v: &Variable) {
         Causality::Parameter => ("parameter", "fixed", Some("exact")),
         Causality::Input => ("input", "continuous", None),
         Causality::Output => ("output", "continuous", Some("calculated")),
+        Causality::Local => ("local", "continuous", Some("calculated")),
     };
     let _ = writeln!(x, "    <!-- index {index} -->");
     let _ = write!(
@@ -210,11 +211,14 @@ fn write_variable(x: &mut String, index: usize, v: &Variable) {
         let _ = write!(x, " description=\"{}\"", escape(d));
     }
     x.push_str(">\n      <Real");
+    if let Some(k) = v.derivative {
+        let _ = write!(x, " derivative=\"{k}\"");
+    }
     if let Some(u) = &v.unit {
         let _ = write!(x, " unit=\"{}\"", escape(u));
     }
-    // Outputs are calculated: a start value is not allowed.
-    if let (Some(s), false) = (v.start, v.causality == Causality::Output) {
+    // Calculated variables (outputs, states) may not have a start value.
+    if let (Some(s), false) = (v.start, matches!(v.causality, Causality::Output | Causality::Local)) {
         let _ = write!(x, " start=\"{}\"", real(s));
     }
     x.push_str("/>\n    </ScalarVariable>\n");
@@ -277,36 +281,78 @@ fn unknown(x: &mut String, index: usize, deps: &BTreeSet<usize>) {
 }
 
 fn write_structure(x: &mut String, model: &Model, vars: &[Variable]) {
-    // FMI index (1-based ModelVariables position) of each parameter and input.
+    // FMI index (1-based ModelVariables position) of each parameter, input and state.
     let mut param_index = Vec::new();
     let mut input_index = vec![0; model.inputs.len()];
-    let mut outputs = Vec::new();
+    let mut state_index = BTreeSet::new();
+    let mut unknowns = Vec::new(); // (index, dependencies at communication points)
     for (k, v) in vars.iter().enumerate() {
         match v.target {
             Target::Parameter(_) => param_index.push(k + 1),
             Target::Input(i) => input_index[i] = k + 1,
-            Target::Output(o) => outputs.push((k + 1, o)),
+            Target::State(_) | Target::StateDerivative(_) => {
+                state_index.insert(k + 1);
+            }
+            _ => {}
         }
-    }
-    if outputs.is_empty() {
-        x.push_str("  <ModelStructure/>\n");
-        return;
     }
     let to_fmi =
         |s: &BTreeSet<usize>| -> BTreeSet<usize> { s.iter().filter_map(|i| input_index.get(*i).copied()).collect() };
-    let step_deps: Vec<BTreeSet<usize>> =
-        outputs.iter().map(|(_, o)| to_fmi(&output_input_deps(model, &model.outputs[*o].function))).collect();
-    let static_inputs = if model.static_analysis { to_fmi(&force_inputs(model)) } else { BTreeSet::new() };
-
-    x.push_str("  <ModelStructure>\n    <Outputs>\n");
-    for ((index, _), d) in outputs.iter().zip(&step_deps) {
-        unknown(x, *index, d);
+    let mut derivatives = Vec::new();
+    for (k, v) in vars.iter().enumerate() {
+        match v.target {
+            // An output depends on its inputs and, through the motion, on every state.
+            Target::Output(o) => {
+                let mut d = to_fmi(&output_input_deps(model, &model.outputs[o].function));
+                d.extend(&state_index);
+                unknowns.push((k + 1, d));
+            }
+            // der(S) is the state W itself.
+            Target::StateDerivative(_) => {
+                let d: BTreeSet<usize> = [k + 1].into();
+                derivatives.push((k + 1, d.clone()));
+                unknowns.push((k + 1, d));
+            }
+            // der(S, 2) = Ẇ: from the equations of motion, all states and force inputs.
+            Target::StateSecondDerivative(_) => {
+                let mut d = state_index.clone();
+                d.extend(to_fmi(&force_inputs(model)));
+                derivatives.push((k + 1, d.clone()));
+                unknowns.push((k + 1, d));
+            }
+            Target::State(_) => unknowns.push((k + 1, state_index.clone())),
+            _ => {}
+        }
     }
-    x.push_str("    </Outputs>\n    <InitialUnknowns>\n");
-    // Outputs are already in index order.
-    for ((index, _), d) in outputs.iter().zip(&step_deps) {
+    if unknowns.is_empty() {
+        x.push_str("  <ModelStructure/>\n");
+        return;
+    }
+    let static_inputs = if model.static_analysis { to_fmi(&force_inputs(model)) } else { BTreeSet::new() };
+    x.push_str("  <ModelStructure>\n");
+    let outputs: Vec<&(usize, BTreeSet<usize>)> =
+        unknowns.iter().filter(|(i, _)| matches!(vars[i - 1].target, Target::Output(_))).collect();
+    if !outputs.is_empty() {
+        x.push_str("    <Outputs>\n");
+        for (index, d) in outputs {
+            unknown(x, *index, d);
+        }
+        x.push_str("    </Outputs>\n");
+    }
+    if !derivatives.is_empty() {
+        x.push_str("    <Derivatives>\n");
+        for (index, d) in &derivatives {
+            unknown(x, *index, d);
+        }
+        x.push_str("    </Derivatives>\n");
+    }
+    // Initialization Mode: knowns are parameters (initial="exact") and inputs; states are
+    // computed from them (assembly), so every unknown depends on every parameter.
+    x.push_str("    <InitialUnknowns>\n");
+    unknowns.sort_by_key(|(i, _)| *i);
+    for (index, d) in &unknowns {
         let mut init: BTreeSet<usize> = param_index.iter().copied().collect();
-        init.extend(d);
+        init.extend(d.iter().filter(|i| !state_index.contains(i)));
         init.extend(&static_inputs);
         unknown(x, *index, &init);
     }
@@ -390,14 +436,16 @@ mod tests {
     }
 
     #[test]
-    fn a_model_without_outputs_or_units_has_an_empty_structure() {
+    fn a_model_without_outputs_or_units_lists_only_its_states() {
         let text = r#"<multibody name="bare" version="1">
   <parameter name="m" value="2"/>
   <body name="b" mass="m" inertia="1 1 1" position="0 0 0"/>
 </multibody>"#;
         let model = crate::model::load_str(text, "bare.xml").unwrap_or_else(|e| panic!("{e}"));
         let xml = write(&model, text);
-        assert!(xml.contains("  <ModelStructure/>\n</fmiModelDescription>\n"), "{xml}");
+        // A free body: six internal states, their velocities and accelerations.
+        assert!(xml.contains(r#"name="b.x""#) && xml.contains(r#"name="der(b.phi,2)""#), "{xml}");
+        assert!(xml.contains("<Derivatives>"), "{xml}");
         assert!(!xml.contains("UnitDefinitions") && !xml.contains("<Outputs"), "{xml}");
     }
 

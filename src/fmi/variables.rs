@@ -1,7 +1,8 @@
 //! The FMI variables of a model and their value references: parameters first, then
-//! inputs, then outputs, numbered consecutively from 0 in model order. The packer writes
-//! them into modelDescription.xml and the C API resolves value references with them, so
-//! both always agree.
+//! inputs, then outputs, then the linearization states S, their velocities `der(S)` (also
+//! states) and accelerations `der(S,2)`, numbered consecutively from 0 in model order. The
+//! packer writes them into modelDescription.xml and the C API resolves value references
+//! with them, so both always agree.
 
 use crate::model::Model;
 
@@ -11,6 +12,8 @@ pub enum Causality {
     Parameter,
     Input,
     Output,
+    /// Linearization states and their derivatives.
+    Local,
 }
 
 /// What a value reference denotes in the engine.
@@ -22,6 +25,12 @@ pub enum Target {
     Input(usize),
     /// Index into `Model::outputs`.
     Output(usize),
+    /// Linearization state S_k.
+    State(usize),
+    /// Its velocity W_k = der(S_k) (a state too).
+    StateDerivative(usize),
+    /// Its acceleration der(S_k, 2) = der(W_k).
+    StateSecondDerivative(usize),
 }
 
 /// One FMI scalar variable (all are Real).
@@ -35,6 +44,8 @@ pub struct Variable {
     pub start: Option<f64>,
     pub unit: Option<String>,
     pub description: Option<String>,
+    /// For a state derivative: the 1-based ModelVariables index of its state.
+    pub derivative: Option<usize>,
 }
 
 /// All FMI variables of a model, in ModelVariables order (index + 1 = FMI index).
@@ -49,6 +60,7 @@ pub fn variables(model: &Model) -> Vec<Variable> {
             start: Some(p.value.value),
             unit: p.unit.clone(),
             description: p.description.clone(),
+            derivative: None,
         });
     }
     for (k, i) in model.inputs.iter().enumerate() {
@@ -60,6 +72,7 @@ pub fn variables(model: &Model) -> Vec<Variable> {
             start: Some(i.start.value),
             unit: i.unit.clone(),
             description: None,
+            derivative: None,
         });
     }
     for (k, o) in model.outputs.iter().enumerate() {
@@ -71,7 +84,39 @@ pub fn variables(model: &Model) -> Vec<Variable> {
             start: None,
             unit: o.unit.clone(),
             description: None,
+            derivative: None,
         });
     }
+    let names = state_names(model);
+    let first = v.len();
+    let s = names.len();
+    for (level, (prefix, suffix)) in [("", ""), ("der(", ")"), ("der(", ",2)")].into_iter().enumerate() {
+        for (k, name) in names.iter().enumerate() {
+            let target = match level {
+                0 => Target::State(k),
+                1 => Target::StateDerivative(k),
+                _ => Target::StateSecondDerivative(k),
+            };
+            v.push(Variable {
+                name: format!("{prefix}{name}{suffix}"),
+                value_reference: v.len() as u32,
+                causality: Causality::Local,
+                target,
+                start: None,
+                unit: None,
+                description: (level == 0).then(|| "linearization state (seed Eq. 33)".to_string()),
+                // 1-based index of the variable this one is the derivative of.
+                derivative: (level > 0).then(|| first + (level - 1) * s + k + 1),
+            });
+        }
+    }
     v
+}
+
+/// Names of the linearization states the FMU exposes (selected from the assembled initial
+/// configuration); none when the model cannot be initialized or linearized.
+pub fn state_names(model: &Model) -> Vec<String> {
+    crate::linearize::selection_at_start(model)
+        .map(|sel| sel.states.iter().map(|s| s.name.clone()).collect())
+        .unwrap_or_default()
 }

@@ -60,14 +60,21 @@ def test_packed_fmu_validates(model: Path, tmp_path: Path):
         )
         assert z.read("resources/model.xml") == model.read_bytes()
 
-    # The variables are the model's parameters, inputs and outputs, in file order, with
-    # value references 0, 1, 2, ...
+    # The variables are the model's parameters, inputs and outputs, in file order, then the
+    # linearization states S, their velocities der(S) and accelerations der(S,2); value
+    # references 0, 1, 2, ...
     root = ET.parse(model).getroot()
     expected = [(e.get("name"), c) for tag, c in (("parameter", "parameter"), ("input", "input"), ("output", "output"))
                 for e in root.iter(tag)]
     actual = [(v.name, v.causality) for v in md.modelVariables]
-    assert actual == expected
-    assert [v.valueReference for v in md.modelVariables] == list(range(len(expected)))
+    assert actual[: len(expected)] == expected
+    local = [name for name, c in actual[len(expected):]]
+    assert all(c == "local" for _, c in actual[len(expected):])
+    s = len(local) // 3
+    assert len(local) == 3 * s
+    assert local[s:2 * s] == [f"der({n})" for n in local[:s]]
+    assert local[2 * s:] == [f"der({n},2)" for n in local[:s]]
+    assert [v.valueReference for v in md.modelVariables] == list(range(len(actual)))
     assert md.defaultExperiment is not None
 
     # Every unit used is defined (validate_fmu checks it too) and none is unused.
