@@ -1,0 +1,39 @@
+//! Linearization benchmark: for a model file, time one linearization (Eq. 34) with 1 and
+//! 2 threads, and one integrator Newton iteration for comparison.
+//! Usage: cargo run --release --example lin_bench -- model.xml
+
+use mbfmu::dae::{SimOptions, Simulator};
+use mbfmu::linearize::{linearize, select_states};
+use mbfmu::model::parse::load_file;
+use std::time::Instant;
+
+fn main() {
+    let path = std::env::args().nth(1).expect("model file");
+    let model = load_file(std::path::Path::new(&path)).unwrap_or_else(|e| panic!("{e}"));
+    let mut sim =
+        Simulator::new(&model, SimOptions { tol: 1e-6, max_step: None }, 0.0).unwrap_or_else(|e| panic!("{e}"));
+    let t = Instant::now();
+    let sel = select_states(sim.system(), sim.q(), 0.0, &sim.inputs()).unwrap();
+    let t_select = t.elapsed().as_secs_f64();
+    let t0 = Instant::now();
+    sim.advance(0.01).unwrap();
+    let st = sim.stats();
+    let per_newton = t0.elapsed().as_secs_f64() / st.newton_iterations.max(1) as f64;
+    let mut times = Vec::new();
+    for threads in [1, 2] {
+        let t = Instant::now();
+        let lin = linearize(&mut sim, &sel, threads).unwrap();
+        times.push(t.elapsed().as_secs_f64());
+        assert!(lin.a.nrows() == 2 * sel.states.len());
+    }
+    println!(
+        "{path}: {} states; selection {:.3} s; linearize {:.3} s (1 thread), {:.3} s (2 threads); \
+         one integration step's Newton iteration {:.2e} s (ratio {:.0})",
+        sel.states.len(),
+        t_select,
+        times[0],
+        times[1],
+        per_newton,
+        times[0] / per_newton
+    );
+}
