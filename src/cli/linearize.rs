@@ -30,6 +30,9 @@ pub struct LinearizeArgs {
     /// Integration tolerance (default: the experiment's, else 1e-8).
     #[arg(long)]
     pub tol: Option<f64>,
+    /// Find static equilibrium first (as `<analysis static="true"/>`).
+    #[arg(long = "static")]
+    pub r#static: bool,
     /// Threads for the right-hand sides of the augmented system.
     #[arg(long, default_value_t = 2)]
     pub threads: usize,
@@ -37,10 +40,9 @@ pub struct LinearizeArgs {
 
 /// Run the command.
 pub fn run(args: &LinearizeArgs, out: &mut dyn Write) -> Result<(), CliError> {
-    let model = load_file(&args.model)?;
-    if model.static_analysis {
-        return Err(CliError::Usage("static equilibrium (<analysis static=\"true\"/>) is not implemented yet".into()));
-    }
+    let mut model = load_file(&args.model)?;
+    // --static: start from static equilibrium, as <analysis static="true"/> does.
+    model.static_analysis |= args.r#static;
     let t0 = model.experiment.start.unwrap_or(0.0);
     let tol = args.tol.or(model.experiment.tolerance).unwrap_or(1e-8);
     if tol.is_nan() || tol <= 0.0 {

@@ -211,3 +211,70 @@ pub fn accelerations(
     }
     Ok((rhs[..n].to_vec(), rhs[n..].to_vec()))
 }
+
+/// Static equilibrium (`<analysis static="true"/>`): positions q and multipliers λ with
+/// u = 0 and Q(0, q, t) − Pᵀλ = 0, C(q, t) = 0 (Eq. 1a, 1d at rest), by Newton from the
+/// assembled configuration with the exact Jacobian of the equations of motion.
+pub fn static_equilibrium(sys: &System, q: &mut [f64], t: f64, inputs: &[f64], tol: f64) -> Result<Vec<f64>, String> {
+    use super::equations::{Layout, jacobian, rhs};
+    let (n, m) = (sys.n(), sys.m);
+    let lay = Layout { n, m };
+    let mut y = vec![0.0; lay.dim()];
+    y[..n].copy_from_slice(q);
+    let mut lu = SparseLu::new();
+    // Start from the multipliers at rest: the stiffness of a mechanism under gravity is in
+    // the reactions' geometric term (Pᵀλ)_q, absent at λ = 0.
+    let (_, lam0) = accelerations(sys, q, &vec![0.0; n], t, inputs, &mut lu)?;
+    y[2 * n..2 * n + m].copy_from_slice(&lam0);
+    let mut f = vec![0.0; lay.dim()];
+    let scale = 1.0 + sys.bodies.iter().map(|b| b.mass).sum::<f64>() * sys.gravity.iter().map(|g| g.abs()).sum::<f64>();
+    for _ in 0..100 {
+        rhs(sys, lay, t, &y, inputs, &mut f);
+        // Unknowns (q, λ); equations: the u rows (force balance) and the C rows.
+        let mut r = vec![0.0; n + m];
+        r[..n].copy_from_slice(&f[n..2 * n]);
+        r[n..].copy_from_slice(&f[2 * n..2 * n + m]);
+        let worst = r.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        if !worst.is_finite() {
+            return Err("static equilibrium: the equations are not finite".into());
+        }
+        if worst <= tol * scale {
+            q.copy_from_slice(&y[..n]);
+            return Ok(y[2 * n..2 * n + m].to_vec());
+        }
+        let mut jt = Triplets::new();
+        jacobian(sys, lay, t, &y, inputs, &mut jt);
+        let mut k = Triplets::new();
+        for (p, &v) in jt.idx.iter().zip(&jt.vals) {
+            let row = if (n..2 * n).contains(&p.row) {
+                p.row - n
+            } else if (2 * n..2 * n + m).contains(&p.row) {
+                p.row - n
+            } else {
+                continue;
+            };
+            let col = if p.col < n {
+                p.col
+            } else if (2 * n..2 * n + m).contains(&p.col) {
+                p.col - n
+            } else {
+                continue;
+            };
+            k.push(row, col, v);
+        }
+        lu.factor(n + m, &k).map_err(|e| format!("static equilibrium: singular equations ({e})"))?;
+        for v in r.iter_mut() {
+            *v = -*v;
+        }
+        if !lu.solve(&mut r) {
+            return Err("static equilibrium: singular equations (a free body or mechanism without stiffness?)".into());
+        }
+        for i in 0..n {
+            y[i] += r[i];
+        }
+        for i in 0..m {
+            y[2 * n + i] += r[n + i];
+        }
+    }
+    Err("static equilibrium: Newton did not converge in 100 iterations".into())
+}

@@ -264,6 +264,10 @@ impl Simulator {
             }),
             None => EngineError::Numeric(e.msg),
         })?;
+        if model.static_analysis {
+            init::static_equilibrium(&sys, &mut q, t0, &inputs, assembly_tol).map_err(EngineError::Numeric)?;
+            u.iter_mut().for_each(|v| *v = 0.0);
+        }
         init::assemble_velocities(&sys, &q, &mut u, t0, &inputs).map_err(EngineError::Numeric)?;
         let mut acc_lu = SparseLu::new();
         let (udot, lam) = init::accelerations(&sys, &q, &u, t0, &inputs, &mut acc_lu).map_err(EngineError::Numeric)?;
