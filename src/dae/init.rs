@@ -246,13 +246,11 @@ pub fn static_equilibrium(sys: &System, q: &mut [f64], t: f64, inputs: &[f64], t
         jacobian(sys, lay, t, &y, inputs, &mut jt);
         let mut k = Triplets::new();
         for (p, &v) in jt.idx.iter().zip(&jt.vals) {
-            let row = if (n..2 * n).contains(&p.row) {
-                p.row - n
-            } else if (2 * n..2 * n + m).contains(&p.row) {
-                p.row - n
-            } else {
+            // Force-balance rows (u) and constraint rows (C) follow each other.
+            if !(n..2 * n + m).contains(&p.row) {
                 continue;
-            };
+            }
+            let row = p.row - n;
             let col = if p.col < n {
                 p.col
             } else if (2 * n..2 * n + m).contains(&p.col) {
