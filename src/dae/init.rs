@@ -114,17 +114,10 @@ fn redundant(residual: f64) -> String {
     )
 }
 
-/// Consistent velocities: u closest to `u` with P u + C_t = 0 and exact velocity ICs.
-pub fn assemble_velocities(sys: &System, q: &[f64], u: &mut [f64], t: f64, inputs: &[f64]) -> Result<(), String> {
-    let n = sys.n();
-    let m = sys.m;
-    let nic = sys.ic_velocities.len();
-    let mut kkt = Triplets::new();
-    for i in 0..n {
-        kkt.push(i, i, 1.0);
-    }
-    let mut rhs = vec![0.0; n + m + nic];
-    rhs[..n].copy_from_slice(u);
+/// Add the symmetric blocks P and Pᵀ (P = C_q H, Eq. 13a/13d) of a KKT matrix whose
+/// constraint rows start at `n`; returns each constraint row with its C_t.
+fn push_p_blocks(sys: &System, q: &[f64], t: f64, inputs: &[f64], n: usize, kkt: &mut Triplets) -> Vec<(usize, f64)> {
+    let mut rows = Vec::with_capacity(sys.m);
     for el in &sys.constraints {
         let f = constraint_first(sys, el, q, t, inputs);
         let nql = NQ * el.bodies.len();
@@ -136,8 +129,25 @@ pub fn assemble_velocities(sys: &System, q: &[f64], u: &mut [f64], t: f64, input
                 kkt.push(r, g, *pa);
                 kkt.push(g, r, *pa);
             }
-            rhs[r] = -f.ct[e];
+            rows.push((r, f.ct[e]));
         }
+    }
+    rows
+}
+
+/// Consistent velocities: u closest to `u` with P u + C_t = 0 and exact velocity ICs.
+pub fn assemble_velocities(sys: &System, q: &[f64], u: &mut [f64], t: f64, inputs: &[f64]) -> Result<(), String> {
+    let n = sys.n();
+    let m = sys.m;
+    let nic = sys.ic_velocities.len();
+    let mut kkt = Triplets::new();
+    for i in 0..n {
+        kkt.push(i, i, 1.0);
+    }
+    let mut rhs = vec![0.0; n + m + nic];
+    rhs[..n].copy_from_slice(u);
+    for (row, ct) in push_p_blocks(sys, q, t, inputs, n, &mut kkt) {
+        rhs[row] = -ct;
     }
     for (k, ic) in sys.ic_velocities.iter().enumerate() {
         // Linear in u: residual(u) = a·u − value; a from dual numbers seeded on u.
@@ -191,19 +201,8 @@ pub fn accelerations(
     let mut rhs = vec![0.0; n + m];
     applied_forces(sys, q, u, t, inputs, &mut rhs[..n]);
     let gamma = acceleration_rhs(sys, q, u, t, inputs);
-    for el in &sys.constraints {
-        let f = constraint_first(sys, el, q, t, inputs);
-        let nql = NQ * el.bodies.len();
-        for e in 0..el.neq {
-            let r = n + el.row + e;
-            let p = p_row(&el.bodies, q, &f.cq[e * nql..(e + 1) * nql]);
-            for (a, pa) in p.iter().enumerate() {
-                let g = NQ * el.bodies[a / NQ] + a % NQ;
-                kkt.push(r, g, *pa);
-                kkt.push(g, r, *pa);
-            }
-            rhs[r] = -gamma[el.row + e];
-        }
+    for (row, _) in push_p_blocks(sys, q, t, inputs, n, &mut kkt) {
+        rhs[row] = -gamma[row - n];
     }
     lu.factor(n + m, &kkt).map_err(|e| format!("cannot solve accelerations: {e}"))?;
     if !lu.solve(&mut rhs) {

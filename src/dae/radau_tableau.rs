@@ -20,21 +20,27 @@ pub struct Tableau {
     pub dd: [f64; 3],
 }
 
+/// The Radau IIA (s = 3) coefficient matrix A in closed form.
+fn radau_a() -> Matrix3<f64> {
+    let s6 = 6f64.sqrt();
+    Matrix3::new(
+        (88.0 - 7.0 * s6) / 360.0,
+        (296.0 - 169.0 * s6) / 1800.0,
+        (-2.0 + 3.0 * s6) / 225.0,
+        (296.0 + 169.0 * s6) / 1800.0,
+        (88.0 + 7.0 * s6) / 360.0,
+        (-2.0 - 3.0 * s6) / 225.0,
+        (16.0 - s6) / 36.0,
+        (16.0 + s6) / 36.0,
+        1.0 / 9.0,
+    )
+}
+
 impl Tableau {
     /// Build from the closed-form coefficients of Radau IIA (s = 3).
     pub fn new() -> Tableau {
         let s6 = 6f64.sqrt();
-        let a = Matrix3::new(
-            (88.0 - 7.0 * s6) / 360.0,
-            (296.0 - 169.0 * s6) / 1800.0,
-            (-2.0 + 3.0 * s6) / 225.0,
-            (296.0 + 169.0 * s6) / 1800.0,
-            (88.0 + 7.0 * s6) / 360.0,
-            (-2.0 - 3.0 * s6) / 225.0,
-            (16.0 - s6) / 36.0,
-            (16.0 + s6) / 36.0,
-            1.0 / 9.0,
-        );
+        let a = radau_a();
         let ainv = a.try_inverse().expect("Radau IIA A is invertible");
         let (c81, c9) = (81f64.cbrt(), 9f64.cbrt());
         let gamma = 30.0 / (6.0 + c81 - c9);
@@ -87,18 +93,7 @@ mod tests {
         let tb = Tableau::new();
         let t = Matrix3::from_fn(|i, j| tb.t[i][j]);
         let ti = Matrix3::from_fn(|i, j| tb.ti[i][j]);
-        let s6 = 6f64.sqrt();
-        let a = Matrix3::new(
-            (88.0 - 7.0 * s6) / 360.0,
-            (296.0 - 169.0 * s6) / 1800.0,
-            (-2.0 + 3.0 * s6) / 225.0,
-            (296.0 + 169.0 * s6) / 1800.0,
-            (88.0 + 7.0 * s6) / 360.0,
-            (-2.0 - 3.0 * s6) / 225.0,
-            (16.0 - s6) / 36.0,
-            (16.0 + s6) / 36.0,
-            1.0 / 9.0,
-        );
+        let a = radau_a();
         let lam = ti * a.try_inverse().unwrap() * t;
         let want = Matrix3::new(tb.gamma, 0.0, 0.0, 0.0, tb.alpha, tb.beta, 0.0, -tb.beta, tb.alpha);
         assert!((lam - want).abs().max() < 1e-12, "{lam}");
