@@ -87,6 +87,12 @@ pub fn rhs(sys: &System, lay: Layout, t: f64, y: &[f64], inputs: &[f64], f: &mut
         let ul = gather(&el.bodies, u);
         for e in 0..el.neq {
             let row = el.row + e;
+            if sys.redundant[row] {
+                // Redundant row: λ = μ = 0 replace C = 0 and Ċ = 0.
+                f[nl + row] = y[nl + row];
+                f[nm + row] = y[nm + row];
+                continue;
+            }
             let cq = &cf.cq[e * nql..(e + 1) * nql];
             let p = p_row(&el.bodies, q, cq);
             let (lam, mu) = (y[nl + row], y[nm + row]);
@@ -159,6 +165,11 @@ pub fn jacobian(sys: &System, lay: Layout, t: f64, y: &[f64], inputs: &[f64], ja
         let mut lq = vec![0.0; nql * nql];
         for e in 0..el.neq {
             let row = el.row + e;
+            if sys.redundant[row] {
+                jac.push(nl + row, nl + row, 1.0);
+                jac.push(nm + row, nm + row, 1.0);
+                continue;
+            }
             let lam = y[nl + row];
             let g = &s.grad[e * k..(e + 1) * k];
             let hs = &s.hess[e * k * k..(e + 1) * k * k];

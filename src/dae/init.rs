@@ -68,8 +68,14 @@ pub fn assemble_positions(sys: &System, q: &mut [f64], t: f64, inputs: &[f64], t
             kkt.push(i, i, 1.0);
         }
         for (r, g, v) in eval_set(sys, &els, q, t, inputs, &mut c) {
+            if r < sys.m && sys.redundant[r] {
+                continue;
+            }
             kkt.push(n + r, g, v);
             kkt.push(g, n + r, v);
+        }
+        for r in (0..sys.m).filter(|&r| sys.redundant[r]) {
+            kkt.push(n + r, n + r, 1.0);
         }
         let worst =
             c.iter().enumerate().fold((0, 0.0f64), |(k, w), (i, v)| if v.abs() > w { (i, v.abs()) } else { (k, w) });
@@ -84,7 +90,7 @@ pub fn assemble_positions(sys: &System, q: &mut [f64], t: f64, inputs: &[f64], t
         }
         let mut rhs = vec![0.0; n + mr];
         for (i, v) in c.iter().enumerate() {
-            rhs[n + i] = -v;
+            rhs[n + i] = if i < sys.m && sys.redundant[i] { 0.0 } else { -v };
         }
         if !lu.solve(&mut rhs) {
             return Err(at_row(&els, worst.0, redundant(worst.1)));
@@ -123,6 +129,11 @@ fn push_p_blocks(sys: &System, q: &[f64], t: f64, inputs: &[f64], n: usize, kkt:
         let nql = NQ * el.bodies.len();
         for e in 0..el.neq {
             let r = n + el.row + e;
+            if sys.redundant[el.row + e] {
+                // Its multiplier is 0 (rhs 0).
+                kkt.push(r, r, 1.0);
+                continue;
+            }
             let p = p_row(&el.bodies, q, &f.cq[e * nql..(e + 1) * nql]);
             for (a, pa) in p.iter().enumerate() {
                 let g = NQ * el.bodies[a / NQ] + a % NQ;
@@ -133,6 +144,40 @@ fn push_p_blocks(sys: &System, q: &[f64], t: f64, inputs: &[f64], n: usize, kkt:
         }
     }
     rows
+}
+
+/// Relative pivot size below which a constraint row counts as redundant.
+pub const REDUNDANCY_TOL: f64 = 1e-6;
+/// Largest n·m for the dense rank-revealing factorization (beyond it: assume independent).
+const REDUNDANCY_DENSE_LIMIT: usize = 4_000_000;
+
+/// Constraint rows that depend on others at (q, t): full-pivot LU of C_qᵀ; the rows that
+/// get no pivot are redundant (e.g. a planar loop of revolutes modelled in 3-D).
+pub fn redundant_rows(sys: &System, q: &[f64], t: f64, inputs: &[f64]) -> Vec<bool> {
+    let (n, m) = (sys.n(), sys.m);
+    let mut red = vec![false; m];
+    if m == 0 || n * m > REDUNDANCY_DENSE_LIMIT {
+        return red;
+    }
+    let mut ct = faer::Mat::<f64>::zeros(n, m);
+    for el in &sys.constraints {
+        let f = constraint_first(sys, el, q, t, inputs);
+        let nql = NQ * el.bodies.len();
+        for e in 0..el.neq {
+            for a in 0..nql {
+                ct[(NQ * el.bodies[a / NQ] + a % NQ, el.row + e)] += f.cq[e * nql + a];
+            }
+        }
+    }
+    let lu = ct.full_piv_lu();
+    let u = lu.U();
+    let k = n.min(m);
+    let big = (0..k).map(|i| u[(i, i)].abs()).fold(0.0, f64::max);
+    let rank = (0..k).take_while(|&i| u[(i, i)].abs() > REDUNDANCY_TOL * big).count();
+    for &c in &lu.Q().arrays().0[rank..] {
+        red[c] = true;
+    }
+    red
 }
 
 /// Consistent velocities: u closest to `u` with P u + C_t = 0 and exact velocity ICs.

@@ -248,12 +248,13 @@ impl Simulator {
     /// Build the equations and initialize at `t0` (assembly, consistent velocities,
     /// accelerations and multipliers).
     pub fn new(model: &Model, opts: SimOptions, t0: f64) -> Result<Simulator, EngineError> {
-        let sys = System::from_model(model).map_err(EngineError::Numeric)?;
+        let mut sys = System::from_model(model).map_err(EngineError::Numeric)?;
         let inputs: Vec<f64> = model.inputs.iter().map(|i| i.start.value).collect();
         let lay = Layout { n: sys.n(), m: sys.m };
         let mut q = sys.q_init.clone();
         let mut u = sys.u_init.clone();
         let assembly_tol = (opts.tol * 1e-3).max(1e-14);
+        sys.redundant = init::redundant_rows(&sys, &q, t0, &inputs);
         init::assemble_positions(&sys, &mut q, t0, &inputs, assembly_tol).map_err(|e| match e.element {
             Some(b) => EngineError::Model(ModelError {
                 file: model.file.clone(),

@@ -34,6 +34,8 @@ pub struct Linearization {
 struct Blocks {
     n: usize,
     m: usize,
+    /// Independent constraint rows (m minus the redundant ones): 34d–e have this many.
+    mr: usize,
     s: usize,
 }
 
@@ -68,21 +70,22 @@ impl Blocks {
     fn dim(&self) -> usize {
         4 * self.n + 4 * self.s + self.m
     }
-    // Rows: 34a n, 34b n, 34c m, 34d m, 34e m, 34f..34k s each.
+    // Rows: 34a n, 34b n, 34c m (redundant rows: λ = 0), 34d mr, 34e mr, 34f..34k s each.
     fn row(&self, eq: char) -> usize {
-        let (n, m, s) = (self.n, self.m, self.s);
+        let (n, m, mr, s) = (self.n, self.m, self.mr, self.s);
+        let f = 2 * n + m + 2 * mr;
         match eq {
             'a' => 0,
             'b' => n,
             'c' => 2 * n,
             'd' => 2 * n + m,
-            'e' => 2 * n + 2 * m,
-            'f' => 2 * n + 3 * m,
-            'g' => 2 * n + 3 * m + s,
-            'h' => 2 * n + 3 * m + 2 * s,
-            'i' => 2 * n + 3 * m + 3 * s,
-            'j' => 2 * n + 3 * m + 4 * s,
-            _ => 2 * n + 3 * m + 5 * s,
+            'e' => 2 * n + m + mr,
+            'f' => f,
+            'g' => f + s,
+            'h' => f + 2 * s,
+            'i' => f + 3 * s,
+            'j' => f + 4 * s,
+            _ => f + 5 * s,
         }
     }
 }
@@ -103,22 +106,31 @@ fn check_partition(
     let n = sys.n();
     let zeros = vec![0.0; n];
     let mut j = Mat::<f64>::zeros(n, n);
+    let mut row = 0;
     for el in &sys.constraints {
         for (e, jet) in jets(sys, el, q, &zeros, &zeros, t, inputs).iter().enumerate() {
+            if sys.redundant[el.row + e] {
+                continue;
+            }
             for (a, &b) in el.bodies.iter().enumerate() {
                 for c in 0..NQ {
-                    j[(el.row + e, NQ * b + c)] = jet.dg[NQ * a + c];
+                    j[(row, NQ * b + c)] = jet.dg[NQ * a + c];
                 }
             }
+            row += 1;
         }
     }
-    for (k, st) in sel.states.iter().enumerate() {
+    for st in &sel.states {
         let jet = &jets(sys, st, q, &zeros, &zeros, t, inputs)[0];
+        if row >= n {
+            break;
+        }
         for (a, &b) in st.bodies().iter().enumerate() {
             for c in 0..NQ {
-                j[(sys.m + k, NQ * b + c)] = jet.dg[NQ * a + c];
+                j[(row, NQ * b + c)] = jet.dg[NQ * a + c];
             }
         }
+        row += 1;
     }
     let lu = j.full_piv_lu();
     let u = lu.U();
@@ -144,14 +156,22 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
     let (q, u) = (sim.q().to_vec(), sim.u().to_vec());
     let sys = sim.system();
     let (n, m, s) = (sys.n(), sys.m, sel.states.len());
-    if sel.rank != m || s + m != n {
+    // Compact index of each independent constraint row (rows of 34d–e).
+    let mut cmap = vec![None; m];
+    let mut mr = 0;
+    for (r, slot) in cmap.iter_mut().enumerate() {
+        if !sys.redundant[r] {
+            *slot = Some(mr);
+            mr += 1;
+        }
+    }
+    if s + mr != n {
         return Err(EngineError::Numeric(format!(
-            "linearization needs independent constraints: {m} equations, rank {} (redundant constraints)",
-            sel.rank
+            "{s} linearization states do not complete {mr} independent constraints to {n} coordinates"
         )));
     }
     check_partition(sys, sel, &q, t, &inputs)?;
-    let bl = Blocks { n, m, s };
+    let bl = Blocks { n, m, mr, s };
     let mut k = Triplets::new();
     // Eq. 34a, 34b, 34d, 34e from the integrator's exact Jacobian of
     // f = [Hu; Q − Pᵀλ; C; Ċ] at μ = 0.
@@ -178,9 +198,11 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
         } else if r < 2 * n {
             k.push(bl.row('a') + r - n, col, -v); // 34a: M u̇ − (Q − Pᵀλ)
         } else if r < 2 * n + m {
-            k.push(bl.row('e') + r - 2 * n, col, v); // 34e: C
-        } else {
-            k.push(bl.row('d') + r - 2 * n - m, col, v); // 34d: Ċ
+            if let Some(cr) = cmap[r - 2 * n] {
+                k.push(bl.row('e') + cr, col, v); // 34e: C
+            }
+        } else if let Some(cr) = cmap[r - 2 * n - m] {
+            k.push(bl.row('d') + cr, col, v); // 34d: Ċ
         }
     }
     for i in 0..n {
@@ -211,7 +233,11 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
     };
     for el in &sys.constraints {
         for (e, jet) in jets(sys, el, &q, &u, &udot, t, &inputs).iter().enumerate() {
-            push_z(&mut k, bl.row('c') + el.row + e, el.bodies(), &jet.dg2, 1.0, true);
+            if sys.redundant[el.row + e] {
+                k.push(bl.row('c') + el.row + e, bl.lam() + el.row + e, 1.0); // its λ = 0
+            } else {
+                push_z(&mut k, bl.row('c') + el.row + e, el.bodies(), &jet.dg2, 1.0, true);
+            }
         }
     }
     // Eq. 34f–34k for each selected state.

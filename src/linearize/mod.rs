@@ -47,7 +47,7 @@ pub fn selection_by_name(sys: &System, names: &[String]) -> Result<Selection, St
             }
         })
         .collect::<Result<Vec<_>, String>>()?;
-    Ok(Selection { states, dropped: vec![], rank: sys.m })
+    Ok(Selection { states, dropped: vec![], rank: sys.redundant.iter().filter(|r| !**r).count() })
 }
 
 /// Values of the states S, their velocities W = Ṡ and accelerations Ẇ at the current point.

@@ -40,6 +40,9 @@ pub fn select_states(sys: &System, q: &[f64], t: f64, inputs: &[f64]) -> Result<
         let f = constraint_first(sys, el, q, t, inputs);
         let nql = NQ * el.bodies.len();
         for e in 0..el.neq {
+            if sys.redundant[el.row + e] {
+                continue; // left as a zero row: it adds no rank
+            }
             for a in 0..nql {
                 j[(el.row + e, NQ * el.bodies[a / NQ] + a % NQ)] += f.cq[e * nql + a];
             }

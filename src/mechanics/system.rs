@@ -43,6 +43,10 @@ pub struct System {
     pub constraints: Vec<ConstraintEl>,
     /// Number of constraint equations m.
     pub m: usize,
+    /// Constraint rows found redundant at initialization (e.g. a planar loop of revolutes
+    /// in 3-D): their multipliers are fixed to 0 and their equations left out, as
+    /// production codes do; they still hold, since the independent rows imply them.
+    pub redundant: Vec<bool>,
     /// Exact position initial conditions (assembly only), rows after the m constraints.
     pub ic_constraints: Vec<ConstraintEl>,
     /// Exact velocity initial conditions.
@@ -281,6 +285,7 @@ impl System {
             r0,
             constraints,
             m,
+            redundant: vec![false; m],
             ic_constraints,
             ic_velocities,
             forces,
