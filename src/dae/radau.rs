@@ -340,6 +340,7 @@ impl Radau {
                     let qnewt = dyth.clamp(1e-4, 20.0);
                     let hhfac = 0.8 * qnewt.powf(-1.0 / (4.0 + (NIT - 1 - newt) as f64));
                     self.stats.rejected += 1;
+                    self.last_rejected = true;
                     self.need_jac = !self.jac_fresh;
                     return Ok((false, h * hhfac));
                 }
@@ -393,8 +394,12 @@ impl Radau {
         }
         let fac = SAFE.min(SAFE * (1 + 2 * NIT) as f64 / (newt + 2 * NIT) as f64);
         let quot = FACR.max(FACL.min(err.powf(0.25) / fac));
-        let hnew = (h / quot).min(self.max_step);
+        let mut hnew = (h / quot).min(self.max_step);
         if err < 1.0 {
+            // After a rejection, do not grow beyond the step that just succeeded (RADAU5).
+            if self.last_rejected {
+                hnew = hnew.min(h);
+            }
             // Accept: y ← y + Z₃, keep the collocation polynomial for extrapolation.
             let c = tb.c;
             let mut cc: [Vec<f64>; 3] = std::array::from_fn(|_| vec![0.0; n]);
