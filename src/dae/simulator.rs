@@ -347,43 +347,37 @@ impl Simulator {
         let (udot, lam) = self.accelerations()?;
         let sys = &self.dae.sys;
         let ids: Vec<usize> = (0..sys.nb()).collect();
-        let ctx_loads = |f: LoadFn, e: ElementRef| -> f64 {
-            self.element_load(e, &lam).map_or(f64::NAN, |(fo, to)| pick(f, fo, to))
-        };
+        let ctx_loads = |f: LoadFn, e: ElementRef| self.load_component(f, e, &lam);
         let inputs = self.dae.inputs_at(self.radau.t);
         let mut ctx = LocalCtx::new(sys, &ids, self.q(), self.u(), &udot, self.radau.t, &inputs);
         ctx.loads = Some(&ctx_loads);
         Ok(sys.outputs.iter().zip(&sys.output_bases).map(|(e, &b)| ctx.eval_expr(e, b)).collect())
     }
 
+    /// Component `f` of the load element `e` applies on its i marker (NaN if it has none).
+    fn load_component(&self, f: LoadFn, e: ElementRef, lam: &[f64]) -> f64 {
+        self.element_load(e, lam).map_or(f64::NAN, |(fo, to)| pick(f, fo, to))
+    }
+
     /// Force and torque (ground; torque about the i marker origin) that an element
-    /// applies on its i marker.
+    /// applies on its i marker, evaluated on the element's own bodies.
     fn element_load(&self, e: ElementRef, lam: &[f64]) -> Option<([f64; 3], [f64; 3])> {
-        let m = self.dae_model_counts();
+        use crate::mechanics::constraints::ConstraintKind;
+        use crate::mechanics::kernels::{constraint_first, gather};
+        use crate::mechanics::system::ElementSlot;
         let sys = &self.dae.sys;
-        let (q, u) = (self.q(), self.u());
-        let ids: Vec<usize> = (0..sys.nb()).collect();
-        let inputs = self.dae.inputs_at(self.radau.t);
-        let ctx = LocalCtx::new(sys, &ids, q, u, &[], self.radau.t, &inputs);
-        let fidx = match e {
-            ElementRef::SpringDamper(k) => Some(k),
-            ElementRef::Sforce(k) => Some(m.1 + k),
-            ElementRef::Gforce(k) => Some(m.1 + m.2 + k),
-            _ => None,
+        let (q, u, t) = (self.q(), self.u(), self.radau.t);
+        let inputs = self.dae.inputs_at(t);
+        let el = match sys.element_slot(e) {
+            ElementSlot::Force(k) => {
+                let el = sys.forces.get(k)?;
+                let (ql, ul) = (gather(&el.bodies, q), gather(&el.bodies, u));
+                let l = el.load(&LocalCtx::new(sys, &el.bodies, &ql, &ul, &[], t, &inputs));
+                return Some((l.force.val(), l.torque.val()));
+            }
+            ElementSlot::Constraint(k) => sys.constraints.get(k)?,
         };
-        if let Some(k) = fidx {
-            let l = sys.forces.get(k)?.load(&ctx);
-            return Some((l.force.val(), l.torque.val()));
-        }
-        let cidx = match e {
-            ElementRef::Joint(k) => k,
-            ElementRef::Motion(k) => m.0 + k,
-            ElementRef::Constraint(k) => m.0 + m.3 + k,
-            _ => return None,
-        };
-        let el = sys.constraints.get(cidx)?;
-        let f =
-            crate::mechanics::kernels::constraint_first(sys, el, q, self.radau.t, &self.dae.inputs_at(self.radau.t));
+        let f = constraint_first(sys, el, q, t, &inputs);
         let nql = NQ * el.bodies.len();
         let mut genf = vec![0.0; nql];
         for e in 0..el.neq {
@@ -393,12 +387,13 @@ impl Simulator {
             }
         }
         let (mi, mj) = match &el.kind {
-            crate::mechanics::constraints::ConstraintKind::Joint { i, j, .. }
-            | crate::mechanics::constraints::ConstraintKind::Rotation { i, j, .. }
-            | crate::mechanics::constraints::ConstraintKind::Translation { i, j, .. } => (*i, Some(*j)),
-            crate::mechanics::constraints::ConstraintKind::User { .. } => return None,
+            ConstraintKind::Joint { i, j, .. }
+            | ConstraintKind::Rotation { i, j, .. }
+            | ConstraintKind::Translation { i, j, .. } => (*i, Some(*j)),
+            ConstraintKind::User { .. } => return None,
         };
-        let pi = ctx_pose(&ctx, mi);
+        let ql = gather(&el.bodies, q);
+        let pi = ctx_pose(&LocalCtx::new(sys, &el.bodies, &ql, &[], &[], t, &inputs), mi);
         // Reaction on a body, moved to the point p_i.
         let on_body = |b: usize| -> ([f64; 3], [f64; 3]) {
             let k = el.bodies.iter().position(|&x| x == b).expect("element body");
@@ -416,34 +411,6 @@ impl Simulator {
             }
             _ => None,
         }
-    }
-
-    fn dae_model_counts(&self) -> (usize, usize, usize, usize) {
-        let s = &self.dae.sys;
-        let nj = s
-            .constraints
-            .iter()
-            .filter(|c| matches!(c.kind, crate::mechanics::constraints::ConstraintKind::Joint { .. }))
-            .count();
-        let nsd = s
-            .forces
-            .iter()
-            .filter(|f| matches!(f.kind, crate::mechanics::forces::ForceKind::SpringDamper { .. }))
-            .count();
-        let nsf =
-            s.forces.iter().filter(|f| matches!(f.kind, crate::mechanics::forces::ForceKind::Sforce { .. })).count();
-        let nmo = s
-            .constraints
-            .iter()
-            .filter(|c| {
-                matches!(
-                    c.kind,
-                    crate::mechanics::constraints::ConstraintKind::Rotation { .. }
-                        | crate::mechanics::constraints::ConstraintKind::Translation { .. }
-                )
-            })
-            .count();
-        (nj, nsd, nsf, nmo)
     }
 
     /// Largest |C_i(q, t)| over the holonomic constraints at the current time.
@@ -585,9 +552,7 @@ impl Simulator {
         let inputs = self.dae.inputs_at(t);
         let sys = &self.dae.sys;
         let ids: Vec<usize> = (0..sys.nb()).collect();
-        let ctx_loads = |f: LoadFn, e: ElementRef| -> f64 {
-            self.element_load(e, &lam).map_or(f64::NAN, |(fo, to)| pick(f, fo, to))
-        };
+        let ctx_loads = |f: LoadFn, e: ElementRef| self.load_component(f, e, &lam);
         let mut ctx = LocalCtx::new(sys, &ids, &qv, &uv, &av, D { v: t, d: [1.0] }, &inputs);
         ctx.input_values = Some(mk(&inputs, &self.dae.slopes));
         ctx.loads = Some(&ctx_loads);

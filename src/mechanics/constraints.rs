@@ -33,6 +33,14 @@ pub struct ConstraintEl {
     pub pos: SrcPos,
 }
 
+impl ConstraintEl {
+    /// An element from model element `tag` at `pos`; its rows are laid out later.
+    pub fn new(name: String, kind: ConstraintKind, bodies: Vec<usize>, tag: &'static str, pos: SrcPos) -> Self {
+        let neq = kind.neq();
+        ConstraintEl { name, kind, bodies, neq, row: 0, tag, pos }
+    }
+}
+
 impl ConstraintKind {
     /// Number of equations.
     pub fn neq(&self) -> usize {

@@ -9,9 +9,9 @@ use super::body::NQ;
 use super::constraints::{ConstraintEl, ConstraintKind, VelocityIc};
 use super::forces::{ForceEl, ForceKind};
 use super::kernels::MAX_ELEMENT_BODIES;
-use crate::geom::{M3, euler313_from_matrix, rot_x};
-use crate::model::expr::{Expr, angle_count, deps};
-use crate::model::{JointType, Model, MotionDof, Orientation, SpringType};
+use crate::geom::{M3, rot_x};
+use crate::model::expr::{ElementRef, Expr, angle_count, deps};
+use crate::model::{Model, MotionDof, Orientation};
 
 /// A marker's fixed geometry: offset `s` and rotation relative to its body (or ground).
 #[derive(Clone, Debug)]
@@ -52,6 +52,12 @@ pub struct System {
     /// Exact velocity initial conditions.
     pub ic_velocities: Vec<VelocityIc>,
     pub forces: Vec<ForceEl>,
+    /// Where motions and user constraints start in `constraints` (joints come first),
+    /// and sforces and gforces in `forces` (spring-dampers first).
+    first_motion: usize,
+    first_user_constraint: usize,
+    first_sforce: usize,
+    first_gforce: usize,
     pub output_names: Vec<String>,
     pub input_names: Vec<String>,
     pub outputs: Vec<Expr>,
@@ -65,6 +71,15 @@ pub struct System {
     /// Initial (unassembled) coordinates and velocities from the model file.
     pub q_init: Vec<f64>,
     pub u_init: Vec<f64>,
+}
+
+/// Where an element named in an expression (`fx(name)` ...) lives in the system.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ElementSlot {
+    /// Index into `System::constraints`.
+    Constraint(usize),
+    /// Index into `System::forces`.
+    Force(usize),
 }
 
 /// Rotation matrix of an orientation attribute (columns = frame axes in owner axes).
@@ -136,38 +151,32 @@ impl System {
         let mut ic_velocities = Vec::new();
         for jt in &model.joints {
             let bl = bodies_of(&[jt.i, jt.j], &[]);
-            constraints.push(ConstraintEl {
-                name: jt.name.clone(),
-                kind: ConstraintKind::Joint { kind: jt.kind, i: jt.i, j: jt.j },
-                bodies: bl.clone(),
-                neq: jt.kind.equations(),
-                row: 0,
-                tag: "joint",
-                pos: jt.pos,
-            });
+            constraints.push(ConstraintEl::new(
+                jt.name.clone(),
+                ConstraintKind::Joint { kind: jt.kind, i: jt.i, j: jt.j },
+                bl.clone(),
+                "joint",
+                jt.pos,
+            ));
             if let Some(a) = &jt.ic_angle {
                 let kind = ConstraintKind::Rotation { i: jt.i, j: jt.j, f: Expr::Num(a.value), abase: 0 };
-                ic_constraints.push(ConstraintEl {
-                    name: format!("{} (ic_angle)", jt.name),
+                ic_constraints.push(ConstraintEl::new(
+                    format!("{} (ic_angle)", jt.name),
                     kind,
-                    bodies: bl.clone(),
-                    neq: 1,
-                    row: 0,
-                    tag: "joint",
-                    pos: jt.pos,
-                });
+                    bl.clone(),
+                    "joint",
+                    jt.pos,
+                ));
             }
             if let Some(d) = &jt.ic_displacement {
                 let kind = ConstraintKind::Translation { i: jt.i, j: jt.j, f: Expr::Num(d.value), abase: 0 };
-                ic_constraints.push(ConstraintEl {
-                    name: format!("{} (ic_displacement)", jt.name),
+                ic_constraints.push(ConstraintEl::new(
+                    format!("{} (ic_displacement)", jt.name),
                     kind,
-                    bodies: bl.clone(),
-                    neq: 1,
-                    row: 0,
-                    tag: "joint",
-                    pos: jt.pos,
-                });
+                    bl.clone(),
+                    "joint",
+                    jt.pos,
+                ));
             }
             for (angular, v) in [(true, &jt.ic_angular_speed), (false, &jt.ic_speed)] {
                 if let Some(v) = v {
@@ -190,27 +199,17 @@ impl System {
                 MotionDof::Rotation => ConstraintKind::Rotation { i, j, f, abase },
                 MotionDof::Translation => ConstraintKind::Translation { i, j, f, abase },
             };
-            constraints.push(ConstraintEl {
-                name: mo.name.clone(),
-                kind,
-                bodies: bl,
-                neq: 1,
-                row: 0,
-                tag: "motion",
-                pos: mo.pos,
-            });
+            constraints.push(ConstraintEl::new(mo.name.clone(), kind, bl, "motion", mo.pos));
         }
         for uc in &model.constraints {
             let bl = bodies_of(&[], &[&uc.function]);
-            constraints.push(ConstraintEl {
-                name: uc.name.clone(),
-                kind: ConstraintKind::User { f: uc.function.clone(), abase: alloc(&uc.function) },
-                bodies: bl,
-                neq: 1,
-                row: 0,
-                tag: "constraint",
-                pos: uc.pos,
-            });
+            constraints.push(ConstraintEl::new(
+                uc.name.clone(),
+                ConstraintKind::User { f: uc.function.clone(), abase: alloc(&uc.function) },
+                bl,
+                "constraint",
+                uc.pos,
+            ));
         }
         let mut row = 0;
         for c in constraints.iter_mut().chain(ic_constraints.iter_mut()) {
@@ -276,13 +275,16 @@ impl System {
                 ));
             }
         }
-        let _ = (JointType::Fixed, SpringType::Rotational, euler313_from_matrix::<f64>);
         Ok(System {
             params,
             gravity: model.gravity,
             bodies,
             markers,
             r0,
+            first_motion: model.joints.len(),
+            first_user_constraint: model.joints.len() + model.motions.len(),
+            first_sforce: model.spring_dampers.len(),
+            first_gforce: model.spring_dampers.len() + model.sforces.len(),
             constraints,
             m,
             redundant: vec![false; m],
@@ -302,6 +304,18 @@ impl System {
             q_init,
             u_init,
         })
+    }
+
+    /// The constraint or force element that `e` names.
+    pub fn element_slot(&self, e: ElementRef) -> ElementSlot {
+        match e {
+            ElementRef::Joint(k) => ElementSlot::Constraint(k),
+            ElementRef::Motion(k) => ElementSlot::Constraint(self.first_motion + k),
+            ElementRef::Constraint(k) => ElementSlot::Constraint(self.first_user_constraint + k),
+            ElementRef::SpringDamper(k) => ElementSlot::Force(k),
+            ElementRef::Sforce(k) => ElementSlot::Force(self.first_sforce + k),
+            ElementRef::Gforce(k) => ElementSlot::Force(self.first_gforce + k),
+        }
     }
 
     /// Number of bodies.
