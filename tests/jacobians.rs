@@ -43,7 +43,18 @@ const KITCHEN_SINK: &str = r#"<multibody name="sink" version="1">
   <sforce name="fr" type="rotational" i="c.cm" j="a.m1" function="-2*az(c.cm, a.m1) - 0.4*wz(c.cm, a.m1, a.m1)"/>
   <gforce name="g1" i="a.m2" j="b.m1" frame="c.m1" force="vx(a.m2, b.m1)*2, -dy(a.m2), 1+time" torque="wz(a.m2)*0.5, 0.2, -dz(b.cm, a.cm, c.m1)"/>
   <gforce name="g2" i="c.m1" force="0 0 3" torque="0.1*wx(c.cm) 0 0"/>
+  <bushing name="bu" i="a.m2" j="b.m1" stiffness="10 20 30 4 5 6" damping="0.1 0.2 0.3 0.04 0.05 0.06"/>
+  <input name="v"/>
+  <variable name="loop1" function="0.3*loop2 + dx(a.m1, b.cm) + v*xi"/>
+  <variable name="loop2" function="-0.2*loop1^2 + sin(xi) + wz(c.cm)"/>
+  <differential name="xi" start="0.2" function="loop1 - 0.5*xi + vx(b.cm)"/>
+  <differential name="filt" start="-0.1" implicit="true" function="0.3*dif1(filt) + filt^3 - loop2*dif1(xi)"/>
+  <sforce name="fu" type="translational" i="a.cm" j="c.cm" function="2*loop1 + filt*v - xi"/>
+  <gforce name="g3" i="b.cm" force="loop2 dif1(filt) 0" torque="0 0 xi*wz(b.cm)"/>
 </multibody>"#;
+
+/// The input value used at every evaluation.
+const INPUTS: [f64; 1] = [0.7];
 
 /// Pseudo-random numbers in [-1, 1] (LCG, reproducible).
 fn rng(seed: &mut u64) -> f64 {
@@ -54,12 +65,16 @@ fn rng(seed: &mut u64) -> f64 {
 fn setup() -> (System, Layout, Vec<f64>) {
     let model = load_str(KITCHEN_SINK, "sink.xml").unwrap_or_else(|e| panic!("{e}"));
     let sys = System::from_model(&model).unwrap();
-    let lay = Layout { n: sys.n(), m: sys.m };
+    let lay = Layout::of(&sys);
+    assert_eq!((lay.nx, lay.nv), (2, 2));
     let mut seed = 7;
     let mut y = vec![0.0; lay.dim()];
     for i in 0..lay.n {
         y[i] = sys.q_init[i] + 0.1 * rng(&mut seed);
         y[lay.u() + i] = sys.u_init[i] + rng(&mut seed);
+    }
+    for i in 0..lay.nz() {
+        y[lay.z() + i] = rng(&mut seed);
     }
     for i in 0..lay.m {
         y[lay.lam() + i] = 3.0 * rng(&mut seed);
@@ -77,7 +92,7 @@ fn jacobian_of_the_equations_of_motion_matches_central_differences() {
     let t = 0.37;
     let n = lay.dim();
     let mut trip = Triplets::new();
-    jacobian(&sys, lay, t, &y, &[], &mut trip);
+    jacobian(&sys, lay, t, &y, &INPUTS, &mut trip);
     let mut jd = vec![0.0; n * n];
     for (p, v) in trip.idx.iter().zip(&trip.vals) {
         jd[p.row * n + p.col] += v;
@@ -89,8 +104,8 @@ fn jacobian_of_the_equations_of_motion_matches_central_differences() {
         yp[c] += h;
         ym[c] -= h;
         let (mut fp, mut fm) = (vec![0.0; n], vec![0.0; n]);
-        rhs(&sys, lay, t, &yp, &[], &mut fp);
-        rhs(&sys, lay, t, &ym, &[], &mut fm);
+        rhs(&sys, lay, t, &yp, &INPUTS, &mut fp);
+        rhs(&sys, lay, t, &ym, &INPUTS, &mut fm);
         for r in 0..n {
             let fd = (fp[r] - fm[r]) / (2.0 * h);
             let e = (fd - jd[r * n + c]).abs() / jd[r * n + c].abs().max(1.0);

@@ -216,9 +216,9 @@ case!(
 );
 
 case!(
-    m35_unsupported_element,
-    "35_unsupported_element.xml",
-    "35_unsupported_element.xml:4:3: bushing 'bu': element not supported yet"
+    m35_bushing_stiffness_count,
+    "35_bushing_stiffness_count.xml",
+    "35_bushing_stiffness_count.xml:4:44: bushing 'bu': attribute 'stiffness' needs 6 items, found 5"
 );
 
 case!(

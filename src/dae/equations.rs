@@ -1,6 +1,7 @@
-//! The equations of motion as the integrator sees them: y = [q; u; λ; μ] and
+//! The equations of motion as the integrator sees them: y = [q; u; Z; λ; μ] and
 //!   q̇ = H(q)u − C_qᵀμ            (Eq. 13b, with the GGL stabilizing term; μ = 0 exactly)
-//!   M u̇ = Q(u, q, t) − Pᵀλ       (Eq. 13a, P = C_q H)
+//!   M u̇ = Q(u, q, Z, v, t) − Pᵀλ (Eq. 13a, P = C_q H)
+//!   Ẋ' = X-rate unknown, 0 = r(q, u, Z, v, t)  (user rows, Eq. 7a–7b; Z = (X, Ẋ, V))
 //!   0 = C(q, t)                   (Eq. 13e)
 //!   0 = C_q H u + C_t             (Eq. 13d)
 //! with exact sparse Jacobians from the element kernels.
@@ -9,7 +10,8 @@ use super::sparse::Triplets;
 use crate::mechanics::System;
 use crate::mechanics::body::{NQ, h_transpose_times, qdot};
 use crate::mechanics::kernels::{
-    constraint_first, constraint_second, dhtw_dq, dqdot_dq, force_jacobian, force_values, gather, gyroscopic,
+    constraint_first, constraint_second, dhtw_dq, dqdot_dq, force_ext_jacobian, force_jacobian, force_values, gather,
+    gyroscopic, user_jacobian, user_residual,
 };
 
 /// Index layout of y.
@@ -17,24 +19,46 @@ use crate::mechanics::kernels::{
 pub struct Layout {
     pub n: usize,
     pub m: usize,
+    /// Differential states X (their rates Ẋ follow them in Z).
+    pub nx: usize,
+    /// User variables V.
+    pub nv: usize,
 }
 
 impl Layout {
-    /// Total dimension 2n + 2m.
+    /// The layout of a system's equations.
+    pub fn of(sys: &System) -> Layout {
+        Layout { n: sys.n(), m: sys.m, nx: sys.nx, nv: sys.nv }
+    }
+    /// Number of user unknowns Z = (X, Ẋ, V).
+    pub fn nz(&self) -> usize {
+        2 * self.nx + self.nv
+    }
+    /// Total dimension 2n + nz + 2m.
     pub fn dim(&self) -> usize {
-        2 * self.n + 2 * self.m
+        2 * self.n + self.nz() + 2 * self.m
     }
     /// Offset of u.
     pub fn u(&self) -> usize {
         self.n
     }
+    /// Offset of Z.
+    pub fn z(&self) -> usize {
+        2 * self.n
+    }
     /// Offset of λ.
     pub fn lam(&self) -> usize {
-        2 * self.n
+        2 * self.n + self.nz()
     }
     /// Offset of μ.
     pub fn mu(&self) -> usize {
-        2 * self.n + self.m
+        2 * self.n + self.nz() + self.m
+    }
+    /// The external values [inputs; Z] of state `y`.
+    pub fn ext(&self, inputs: &[f64], y: &[f64]) -> Vec<f64> {
+        let mut e = inputs.to_vec();
+        e.extend_from_slice(&y[self.z()..self.z() + self.nz()]);
+        e
     }
 }
 
@@ -76,6 +100,15 @@ pub fn p_row(bodies: &[usize], q: &[f64], cq: &[f64]) -> Vec<f64> {
 pub fn rhs(sys: &System, lay: Layout, t: f64, y: &[f64], inputs: &[f64], f: &mut [f64]) {
     let (n, nu, nl, nm) = (lay.n, lay.u(), lay.lam(), lay.mu());
     let (q, u) = (&y[..n], &y[nu..nu + n]);
+    let ext = lay.ext(inputs, y);
+    let inputs = &ext[..];
+    let nz = lay.z();
+    for i in 0..lay.nx {
+        f[nz + i] = y[nz + lay.nx + i]; // X' = Ẋ
+    }
+    for (k, ue) in sys.user.iter().enumerate() {
+        f[nz + lay.nx + k] = user_residual(sys, ue, q, u, t, inputs); // Eq. 7a–7b
+    }
     for b in 0..sys.nb() {
         let o = NQ * b;
         f[o..o + NQ].copy_from_slice(&qdot(&q[o..o + NQ], &u[o..o + NQ]));
@@ -111,6 +144,27 @@ pub fn rhs(sys: &System, lay: Layout, t: f64, y: &[f64], inputs: &[f64], f: &mut
 pub fn jacobian(sys: &System, lay: Layout, t: f64, y: &[f64], inputs: &[f64], jac: &mut Triplets) {
     let (n, nu, nl, nm) = (lay.n, lay.u(), lay.lam(), lay.mu());
     let (q, u) = (&y[..n], &y[nu..nu + n]);
+    let ext = lay.ext(inputs, y);
+    let inputs = &ext[..];
+    let (nz, ni) = (lay.z(), sys.ni());
+    for i in 0..lay.nx {
+        jac.push(nz + i, nz + lay.nx + i, 1.0);
+    }
+    for (k, ue) in sys.user.iter().enumerate() {
+        let row = nz + lay.nx + k;
+        let uj = user_jacobian(sys, ue, q, u, t, inputs);
+        let nql = NQ * ue.bodies.len();
+        for a in 0..nql {
+            let g = glob(&ue.bodies, a);
+            jac.push(row, g, uj.dqu[a]);
+            jac.push(row, nu + g, uj.dqu[nql + a]);
+        }
+        for (e, v) in uj.dext {
+            if e >= ni {
+                jac.push(row, nz + e - ni, v);
+            }
+        }
+    }
     for (b, body) in sys.bodies.iter().enumerate() {
         let o = NQ * b;
         let (qb, ub) = (&q[o..o + NQ], &u[o..o + NQ]);
@@ -146,6 +200,13 @@ pub fn jacobian(sys: &System, lay: Layout, t: f64, y: &[f64], inputs: &[f64], ja
                 let ga = glob(&el.bodies, a);
                 jac.push(gr, ga, fj[r * 2 * nql + a]);
                 jac.push(gr, nu + ga, fj[r * 2 * nql + nql + a]);
+            }
+        }
+        for (e, col) in force_ext_jacobian(sys, el, q, u, t, inputs) {
+            if e >= ni {
+                for (r, v) in col.iter().enumerate() {
+                    jac.push(nu + glob(&el.bodies, r), nz + e - ni, *v);
+                }
             }
         }
     }
@@ -219,10 +280,13 @@ pub fn jacobian(sys: &System, lay: Layout, t: f64, y: &[f64], inputs: &[f64], ja
     }
 }
 
-/// The constant mass matrix diag(I, M, 0, 0) of the integrator's M y' = f.
+/// The constant mass matrix diag(I, M, [I 0 0], 0, 0) of the integrator's M y' = f.
 pub fn mass_matrix(sys: &System, lay: Layout, m: &mut Triplets) {
     for i in 0..lay.n {
         m.push(i, i, 1.0);
+    }
+    for i in 0..lay.nx {
+        m.push(lay.z() + i, lay.z() + i, 1.0);
     }
     for (b, body) in sys.bodies.iter().enumerate() {
         let o = lay.u() + NQ * b;

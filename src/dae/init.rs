@@ -256,67 +256,109 @@ pub fn accelerations(
     Ok((rhs[..n].to_vec(), rhs[n..].to_vec()))
 }
 
-/// Static equilibrium (`<analysis static="true"/>`): positions q and multipliers λ with
-/// u = 0 and Q(0, q, t) − Pᵀλ = 0, C(q, t) = 0 (Eq. 1a, 1d at rest), by Newton from the
-/// assembled configuration with the exact Jacobian of the equations of motion.
-pub fn static_equilibrium(sys: &System, q: &mut [f64], t: f64, inputs: &[f64], tol: f64) -> Result<Vec<f64>, String> {
+/// Static equilibrium (`<analysis static="true"/>`): positions q, multipliers λ and user
+/// unknowns with u = 0 and Ẋ = 0: Q(0, q, Z, t) − Pᵀλ = 0, C(q, t) = 0 and the user rows
+/// (Eq. 1a, 1d, 7 at rest), by Newton from the assembled configuration with the exact
+/// Jacobian of the equations of motion. `z` holds the user unknowns (X, Ẋ, V) in and out.
+pub fn static_equilibrium(
+    sys: &System,
+    q: &mut [f64],
+    z: &mut [f64],
+    t: f64,
+    inputs: &[f64],
+    tol: f64,
+) -> Result<Vec<f64>, String> {
     use super::equations::{Layout, jacobian, rhs};
     let (n, m) = (sys.n(), sys.m);
-    let lay = Layout { n, m };
+    let lay = Layout::of(sys);
+    let (nz, nl, nx) = (lay.z(), lay.lam(), lay.nx);
     let mut y = vec![0.0; lay.dim()];
     y[..n].copy_from_slice(q);
+    y[nz..nz + lay.nz()].copy_from_slice(z);
+    y[nz + nx..nz + 2 * nx].iter_mut().for_each(|v| *v = 0.0);
     let mut lu = SparseLu::new();
     // Start from the multipliers at rest: the stiffness of a mechanism under gravity is in
     // the reactions' geometric term (Pᵀλ)_q, absent at λ = 0.
-    let (_, lam0) = accelerations(sys, q, &vec![0.0; n], t, inputs, &mut lu)?;
-    y[2 * n..2 * n + m].copy_from_slice(&lam0);
+    let ext = lay.ext(inputs, &y);
+    let (_, lam0) = accelerations(sys, q, &vec![0.0; n], t, &ext, &mut lu)?;
+    y[nl..nl + m].copy_from_slice(&lam0);
+    // Equations: u rows, user rows, C rows; unknowns: q, X, V, λ (Ẋ = 0 held).
+    let rows: Vec<usize> = (n..2 * n).chain(nz + nx..nz + lay.nz()).chain(nl..nl + m).collect();
+    let cols: Vec<usize> = (0..n).chain(nz..nz + nx).chain(nz + 2 * nx..nz + lay.nz()).chain(nl..nl + m).collect();
+    let mut row_of = vec![usize::MAX; lay.dim()];
+    let mut col_of = vec![usize::MAX; lay.dim()];
+    rows.iter().enumerate().for_each(|(k, &r)| row_of[r] = k);
+    cols.iter().enumerate().for_each(|(k, &c)| col_of[c] = k);
+    let dim = rows.len();
     let mut f = vec![0.0; lay.dim()];
     let scale = 1.0 + sys.bodies.iter().map(|b| b.mass).sum::<f64>() * sys.gravity.iter().map(|g| g.abs()).sum::<f64>();
     for _ in 0..100 {
         rhs(sys, lay, t, &y, inputs, &mut f);
-        // Unknowns (q, λ); equations: the u rows (force balance) and the C rows.
-        let mut r = vec![0.0; n + m];
-        r[..n].copy_from_slice(&f[n..2 * n]);
-        r[n..].copy_from_slice(&f[2 * n..2 * n + m]);
+        let mut r: Vec<f64> = rows.iter().map(|&i| f[i]).collect();
         let worst = r.iter().fold(0.0f64, |a, v| a.max(v.abs()));
         if !worst.is_finite() {
             return Err("static equilibrium: the equations are not finite".into());
         }
         if worst <= tol * scale {
             q.copy_from_slice(&y[..n]);
-            return Ok(y[2 * n..2 * n + m].to_vec());
+            z.copy_from_slice(&y[nz..nz + lay.nz()]);
+            return Ok(y[nl..nl + m].to_vec());
         }
         let mut jt = Triplets::new();
         jacobian(sys, lay, t, &y, inputs, &mut jt);
         let mut k = Triplets::new();
         for (p, &v) in jt.idx.iter().zip(&jt.vals) {
-            // Force-balance rows (u) and constraint rows (C) follow each other.
-            if !(n..2 * n + m).contains(&p.row) {
-                continue;
+            let (rr, cc) = (row_of[p.row], col_of[p.col]);
+            if rr != usize::MAX && cc != usize::MAX {
+                k.push(rr, cc, v);
             }
-            let row = p.row - n;
-            let col = if p.col < n {
-                p.col
-            } else if (2 * n..2 * n + m).contains(&p.col) {
-                p.col - n
-            } else {
-                continue;
-            };
-            k.push(row, col, v);
         }
-        lu.factor(n + m, &k).map_err(|e| format!("static equilibrium: singular equations ({e})"))?;
+        lu.factor(dim, &k).map_err(|e| format!("static equilibrium: singular equations ({e})"))?;
         for v in r.iter_mut() {
             *v = -*v;
         }
         if !lu.solve(&mut r) {
             return Err("static equilibrium: singular equations (a free body or mechanism without stiffness?)".into());
         }
-        for i in 0..n {
-            y[i] += r[i];
-        }
-        for i in 0..m {
-            y[2 * n + i] += r[n + i];
+        for (k, &c) in cols.iter().enumerate() {
+            y[c] += r[k];
         }
     }
     Err("static equilibrium: Newton did not converge in 100 iterations".into())
+}
+
+/// The algebraic user unknowns (Ẋ, V) from the user rows (Eq. 7a–7b) at given q, u, X:
+/// Newton with the exact Jacobian; `z` = (X, Ẋ, V) in and out (X is kept).
+pub fn user_unknowns(sys: &System, q: &[f64], u: &[f64], t: f64, inputs: &[f64], z: &mut [f64]) -> Result<(), String> {
+    use crate::mechanics::kernels::user_jacobian;
+    let (nx, ni, k) = (sys.nx, sys.ni(), sys.user.len());
+    if k == 0 {
+        return Ok(());
+    }
+    for _ in 0..50 {
+        let ext = sys.ext(inputs, z);
+        let mut jac = faer::Mat::<f64>::zeros(k, k);
+        let mut r = faer::Mat::<f64>::zeros(k, 1);
+        for (row, ue) in sys.user.iter().enumerate() {
+            let uj = user_jacobian(sys, ue, q, u, t, &ext);
+            r[(row, 0)] = -uj.value;
+            for (e, v) in uj.dext {
+                if e >= ni + nx {
+                    jac[(row, e - ni - nx)] += v;
+                }
+            }
+        }
+        let worst = (0..k).map(|i| r[(i, 0)].abs()).fold(0.0, f64::max);
+        if !worst.is_finite() {
+            return Err("user variables/differentials: not finite at the initial state".into());
+        }
+        if worst <= 1e-13 * (1.0 + z.iter().fold(0.0f64, |a, v| a.max(v.abs()))) {
+            return Ok(());
+        }
+        let dx = faer::linalg::solvers::Solve::solve(&jac.full_piv_lu(), &r);
+        for i in 0..k {
+            z[nx + i] += dx[(i, 0)];
+        }
+    }
+    Err("user variables/differentials: Newton did not converge at the initial state (algebraic loop?)".into())
 }

@@ -165,7 +165,8 @@ impl DaeProblem for MultibodyDae {
         equations::mass_matrix(&self.sys, self.lay, m);
     }
     fn index(&self) -> Vec<u8> {
-        (0..self.lay.dim()).map(|i| if i < 2 * self.lay.n { 0 } else { 2 }).collect()
+        // q, u, X and the index-1 user unknowns (Ẋ, V): error-controlled; λ, μ: index 2.
+        (0..self.lay.dim()).map(|i| if i < self.lay.lam() { 0 } else { 2 }).collect()
     }
     fn accepted(&mut self, t: f64, y: &mut [f64]) -> bool {
         let mut changed = false;
@@ -183,8 +184,9 @@ impl DaeProblem for MultibodyDae {
             }
         }
         let n = self.lay.n;
-        self.record_angles(t, &y[..n], &y[n..2 * n]);
-        let inputs = self.inputs_at(t);
+        let ext = self.lay.ext(&self.inputs_at(t), y);
+        self.record_angles(t, &y[..n], &y[n..2 * n], &ext);
+        let inputs = ext;
         for k in 0..self.sys.forces.len() {
             let el = &self.sys.forces[k];
             let ql = crate::mechanics::kernels::gather(&el.bodies, &y[..n]);
@@ -204,17 +206,19 @@ impl MultibodyDae {
     }
 
     /// Store the current value of every angle measure, so expressions stay on its branch.
-    fn record_angles(&mut self, t: f64, q: &[f64], u: &[f64]) {
+    fn record_angles(&mut self, t: f64, q: &[f64], u: &[f64], inputs: &[f64]) {
         if self.sys.angle_refs.is_empty() {
             return;
         }
         let rec = std::cell::RefCell::new(Vec::new());
-        let inputs = self.inputs_at(t);
         {
             let sys = &self.sys;
             let ids: Vec<usize> = (0..sys.nb()).collect();
-            let mut ctx = LocalCtx::new(sys, &ids, q, u, &[], t, &inputs);
+            let mut ctx = LocalCtx::new(sys, &ids, q, u, &[], t, inputs);
             ctx.record = Some(&rec);
+            for ue in &sys.user {
+                ue.residual(&ctx);
+            }
             for el in &sys.constraints {
                 let mut out = vec![0.0; el.neq];
                 el.kind.eval(&ctx, &mut out);
@@ -250,7 +254,7 @@ impl Simulator {
     pub fn new(model: &Model, opts: SimOptions, t0: f64) -> Result<Simulator, EngineError> {
         let mut sys = System::from_model(model).map_err(EngineError::Numeric)?;
         let inputs: Vec<f64> = model.inputs.iter().map(|i| i.start.value).collect();
-        let lay = Layout { n: sys.n(), m: sys.m };
+        let lay = Layout::of(&sys);
         let mut q = sys.q_init.clone();
         let mut u = sys.u_init.clone();
         let assembly_tol = (opts.tol * 1e-3).max(1e-14);
@@ -265,16 +269,22 @@ impl Simulator {
             }),
             None => EngineError::Numeric(e.msg),
         })?;
+        let mut z = vec![0.0; lay.nz()];
+        z[..lay.nx].copy_from_slice(&sys.x_init);
         if model.static_analysis {
-            init::static_equilibrium(&sys, &mut q, t0, &inputs, assembly_tol).map_err(EngineError::Numeric)?;
             u.iter_mut().for_each(|v| *v = 0.0);
+            init::user_unknowns(&sys, &q, &u, t0, &inputs, &mut z).map_err(EngineError::Numeric)?;
+            init::static_equilibrium(&sys, &mut q, &mut z, t0, &inputs, assembly_tol).map_err(EngineError::Numeric)?;
         }
         init::assemble_velocities(&sys, &q, &mut u, t0, &inputs).map_err(EngineError::Numeric)?;
+        init::user_unknowns(&sys, &q, &u, t0, &inputs, &mut z).map_err(EngineError::Numeric)?;
         let mut acc_lu = SparseLu::new();
-        let (udot, lam) = init::accelerations(&sys, &q, &u, t0, &inputs, &mut acc_lu).map_err(EngineError::Numeric)?;
+        let ext = sys.ext(&inputs, &z);
+        let (udot, lam) = init::accelerations(&sys, &q, &u, t0, &ext, &mut acc_lu).map_err(EngineError::Numeric)?;
         let mut y = vec![0.0; lay.dim()];
         y[..lay.n].copy_from_slice(&q);
         y[lay.u()..lay.u() + lay.n].copy_from_slice(&u);
+        y[lay.z()..lay.z() + lay.nz()].copy_from_slice(&z);
         y[lay.lam()..lay.lam() + lay.m].copy_from_slice(&lam);
         let slopes = vec![0.0; inputs.len()];
         let mut dae = MultibodyDae { sys, lay, inputs, slopes, t_in: t0 };
@@ -328,9 +338,10 @@ impl Simulator {
     pub fn accelerations(&mut self) -> Result<(Vec<f64>, Vec<f64>), EngineError> {
         if self.acc.is_none() {
             let (q, u) = (self.q().to_vec(), self.u().to_vec());
+            let ext = self.ext();
             let s = &self.dae;
             self.acc = Some(
-                init::accelerations(&s.sys, &q, &u, self.radau.t, &s.inputs_at(self.radau.t), &mut self.acc_lu)
+                init::accelerations(&s.sys, &q, &u, self.radau.t, &ext, &mut self.acc_lu)
                     .map_err(EngineError::Numeric)?,
             );
         }
@@ -348,7 +359,7 @@ impl Simulator {
         let sys = &self.dae.sys;
         let ids: Vec<usize> = (0..sys.nb()).collect();
         let ctx_loads = |f: LoadFn, e: ElementRef| self.load_component(f, e, &lam);
-        let inputs = self.dae.inputs_at(self.radau.t);
+        let inputs = self.ext();
         let mut ctx = LocalCtx::new(sys, &ids, self.q(), self.u(), &udot, self.radau.t, &inputs);
         ctx.loads = Some(&ctx_loads);
         Ok(sys.outputs.iter().zip(&sys.output_bases).map(|(e, &b)| ctx.eval_expr(e, b)).collect())
@@ -367,7 +378,7 @@ impl Simulator {
         use crate::mechanics::system::ElementSlot;
         let sys = &self.dae.sys;
         let (q, u, t) = (self.q(), self.u(), self.radau.t);
-        let inputs = self.dae.inputs_at(t);
+        let inputs = self.ext();
         let el = match sys.element_slot(e) {
             ElementSlot::Force(k) => {
                 let el = sys.forces.get(k)?;
@@ -455,7 +466,7 @@ impl Simulator {
         for el in &s.forces {
             let ql = crate::mechanics::kernels::gather(&el.bodies, q);
             let ul = crate::mechanics::kernels::gather(&el.bodies, u);
-            let inputs = self.dae.inputs_at(self.radau.t);
+            let inputs = self.ext();
             let ctx = LocalCtx::new(s, &el.bodies, &ql, &ul, &[], self.radau.t, &inputs);
             e += el.potential(&ctx);
         }
@@ -549,14 +560,33 @@ impl Simulator {
         let uv = mk(&u, &udot);
         let av = mk(&udot, jerk.as_deref().unwrap_or(&vec![0.0; n]));
         let t = self.radau.t;
-        let inputs = self.dae.inputs_at(t);
+        let inputs = self.ext();
+        let lay = self.dae.lay;
+        // Rates of the external values: input slopes; X' = Ẋ; Ẋ', V' from the collocation
+        // polynomial (zero right after a restore).
+        let mut rates = self.dae.slopes.clone();
+        let zd = self.radau.derivatives_at_end().map(|(d1, _)| d1[lay.z()..lay.z() + lay.nz()].to_vec());
+        for i in 0..lay.nz() {
+            rates.push(if i < lay.nx { self.user_values()[lay.nx + i] } else { zd.as_ref().map_or(0.0, |d| d[i]) });
+        }
         let sys = &self.dae.sys;
         let ids: Vec<usize> = (0..sys.nb()).collect();
         let ctx_loads = |f: LoadFn, e: ElementRef| self.load_component(f, e, &lam);
         let mut ctx = LocalCtx::new(sys, &ids, &qv, &uv, &av, D { v: t, d: [1.0] }, &inputs);
-        ctx.input_values = Some(mk(&inputs, &self.dae.slopes));
+        ctx.input_values = Some(mk(&inputs, &rates));
         ctx.loads = Some(&ctx_loads);
         Ok(sys.outputs.iter().zip(&sys.output_bases).map(|(e, &b)| ctx.eval_expr(e, b).d[0]).collect())
+    }
+
+    /// The external values [inputs; Z] at the current time (see [`System::ext`]).
+    pub fn ext(&self) -> Vec<f64> {
+        self.dae.lay.ext(&self.dae.inputs_at(self.radau.t), &self.radau.y)
+    }
+
+    /// Current user unknowns Z = (X, Ẋ, V).
+    pub fn user_values(&self) -> &[f64] {
+        let l = &self.dae.lay;
+        &self.radau.y[l.z()..l.z() + l.nz()]
     }
 
     /// Number of inputs.

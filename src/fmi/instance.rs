@@ -184,6 +184,16 @@ impl Instance {
                         _ => v[2][k],
                     }
                 }
+                Target::Diff(k) | Target::DiffDerivative(k) | Target::UserVariable(k) => {
+                    let sim = self.simulator()?;
+                    let nx = sim.system().nx;
+                    let z = sim.user_values();
+                    match *t {
+                        Target::Diff(_) => z[k],
+                        Target::DiffDerivative(_) => z[nx + k],
+                        _ => z[2 * nx + k],
+                    }
+                }
             };
         }
         Ok(())
@@ -209,6 +219,9 @@ impl Instance {
                         "'{}' (vr {vr}) is a linearization state (computed from the motion) and cannot be set",
                         var.name
                     ));
+                }
+                Target::Diff(_) | Target::DiffDerivative(_) | Target::UserVariable(_) => {
+                    return Err(format!("'{}' (vr {vr}) is computed by the engine and cannot be set", var.name));
                 }
                 Target::Parameter(_) if self.initialized() => {
                     return Err(format!(
@@ -264,15 +277,19 @@ impl Instance {
         dv: &[f64],
         out: &mut [f64],
     ) -> Result<(), String> {
+        let nx = self.vars.iter().filter(|v| matches!(v.target, Target::Diff(_))).count();
+        // Columns of A/C: S, W, X; then inputs (B/D).
         let col = |t: Target, s: usize| match t {
             Target::State(k) => Some(k),
             Target::StateDerivative(k) => Some(s + k),
-            Target::Input(i) => Some(2 * s + i),
+            Target::Diff(k) => Some(2 * s + k),
+            Target::Input(i) => Some(2 * s + nx + i),
             _ => None,
         };
         let row = |t: Target, s: usize| match t {
             Target::StateDerivative(k) => Some((false, k)),
             Target::StateSecondDerivative(k) => Some((false, s + k)),
+            Target::DiffDerivative(k) => Some((false, 2 * s + k)),
             Target::Output(o) => Some((true, o)),
             _ => None,
         };
@@ -301,11 +318,12 @@ impl Instance {
             let mut acc = 0.0;
             for (&(_, k), &d) in kt.iter().zip(dv) {
                 let c = col(k, s).expect("checked");
-                acc += d * match (is_output, c < 2 * s) {
+                let ns = 2 * s + nx;
+                acc += d * match (is_output, c < ns) {
                     (false, true) => lin.a[(r, c)],
-                    (false, false) => lin.b[(r, c - 2 * s)],
+                    (false, false) => lin.b[(r, c - ns)],
                     (true, true) => lin.c[(r, c)],
-                    (true, false) => lin.d[(r, c - 2 * s)],
+                    (true, false) => lin.d[(r, c - ns)],
                 };
             }
             *o = acc;

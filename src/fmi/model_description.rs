@@ -235,6 +235,16 @@ fn force_inputs(model: &Model) -> BTreeSet<usize> {
             s.extend(deps(e).inputs);
         }
     }
+    s.extend(user_inputs(model));
+    s
+}
+
+/// Inputs read by user variables and differentials (which forces and outputs may read).
+fn user_inputs(model: &Model) -> BTreeSet<usize> {
+    let mut s = BTreeSet::new();
+    for e in model.variables.iter().map(|v| &v.function).chain(model.differentials.iter().map(|d| &d.function)) {
+        s.extend(deps(e).inputs);
+    }
     s
 }
 
@@ -244,10 +254,13 @@ pub fn output_input_deps(model: &Model, e: &Expr) -> BTreeSet<usize> {
     let d = deps(e);
     let mut s: BTreeSet<usize> = d.inputs.iter().copied().collect();
     let mut through_accelerations = d.level >= 2;
+    if !(d.variables.is_empty() && d.diff_dots.is_empty()) {
+        s.extend(user_inputs(model));
+    }
     for r in &d.loads {
         match *r {
             ElementRef::Joint(_) | ElementRef::Motion(_) | ElementRef::Constraint(_) => through_accelerations = true,
-            ElementRef::SpringDamper(_) => {}
+            ElementRef::SpringDamper(_) | ElementRef::Bushing(_) => {}
             ElementRef::Sforce(k) => {
                 if let Some(f) = model.sforces.get(k) {
                     s.extend(deps(&f.function).inputs);
@@ -290,7 +303,7 @@ fn write_structure(x: &mut String, model: &Model, vars: &[Variable]) {
         match v.target {
             Target::Parameter(_) => param_index.push(k + 1),
             Target::Input(i) => input_index[i] = k + 1,
-            Target::State(_) | Target::StateDerivative(_) => {
+            Target::State(_) | Target::StateDerivative(_) | Target::Diff(_) => {
                 state_index.insert(k + 1);
             }
             _ => {}
@@ -313,14 +326,14 @@ fn write_structure(x: &mut String, model: &Model, vars: &[Variable]) {
                 derivatives.push((k + 1, d.clone()));
                 unknowns.push((k + 1, d));
             }
-            // der(S, 2) = Ẇ: from the equations of motion, all states and force inputs.
-            Target::StateSecondDerivative(_) => {
+            // der(S, 2) = Ẇ and der(X): from the equations of motion, all states and force inputs.
+            Target::StateSecondDerivative(_) | Target::DiffDerivative(_) => {
                 let mut d = state_index.clone();
                 d.extend(to_fmi(&force_inputs(model)));
                 derivatives.push((k + 1, d.clone()));
                 unknowns.push((k + 1, d));
             }
-            Target::State(_) => unknowns.push((k + 1, state_index.clone())),
+            Target::State(_) | Target::Diff(_) => unknowns.push((k + 1, state_index.clone())),
             _ => {}
         }
     }

@@ -1,6 +1,7 @@
 //! The FMI variables of a model and their value references: parameters first, then
 //! inputs, then outputs, then the linearization states S, their velocities `der(S)` (also
-//! states) and accelerations `der(S,2)`, numbered consecutively from 0 in model order. The
+//! states) and accelerations `der(S,2)`, then the differential states X, `der(X)` and the
+//! user variables V, numbered consecutively from 0 in model order. The
 //! packer writes them into modelDescription.xml and the C API resolves value references
 //! with them, so both always agree.
 
@@ -31,6 +32,12 @@ pub enum Target {
     StateDerivative(usize),
     /// Its acceleration der(S_k, 2) = der(W_k).
     StateSecondDerivative(usize),
+    /// Differential state X_k (`<differential>`, a state).
+    Diff(usize),
+    /// Its derivative der(X_k).
+    DiffDerivative(usize),
+    /// User variable V_k (`<variable>`).
+    UserVariable(usize),
 }
 
 /// One FMI scalar variable (all are Real).
@@ -109,6 +116,43 @@ pub fn variables(model: &Model) -> Vec<Variable> {
                 derivative: (level > 0).then(|| first + (level - 1) * s + k + 1),
             });
         }
+    }
+    let first_x = v.len();
+    for (k, d) in model.differentials.iter().enumerate() {
+        v.push(Variable {
+            name: d.name.clone(),
+            value_reference: v.len() as u32,
+            causality: Causality::Local,
+            target: Target::Diff(k),
+            start: None,
+            unit: None,
+            description: Some("differential state (seed Eq. 7a)".into()),
+            derivative: None,
+        });
+    }
+    for (k, d) in model.differentials.iter().enumerate() {
+        v.push(Variable {
+            name: format!("der({})", d.name),
+            value_reference: v.len() as u32,
+            causality: Causality::Local,
+            target: Target::DiffDerivative(k),
+            start: None,
+            unit: None,
+            description: None,
+            derivative: Some(first_x + k + 1),
+        });
+    }
+    for (k, d) in model.variables.iter().enumerate() {
+        v.push(Variable {
+            name: d.name.clone(),
+            value_reference: v.len() as u32,
+            causality: Causality::Local,
+            target: Target::UserVariable(k),
+            start: None,
+            unit: None,
+            description: Some("user variable (seed Eq. 7b)".into()),
+            derivative: None,
+        });
     }
     v
 }

@@ -10,23 +10,23 @@ use crate::dae::equations::{Layout, jacobian};
 use crate::dae::sparse::{SparseLu, Triplets};
 use crate::dae::{EngineError, Simulator};
 use crate::mechanics::body::NQ;
-use crate::mechanics::kernels::force_input_jacobian;
+use crate::mechanics::kernels::{force_ext_jacobian, user_jacobian};
 use faer::Mat;
 
 /// A, B, C, D at one operating point, with the names of states, inputs and outputs.
 #[derive(Clone, Debug)]
 pub struct Linearization {
     pub time: f64,
-    /// State names: S then W (`der(S)`).
+    /// State names: S, then W (`der(S)`), then the differential states X.
     pub states: Vec<String>,
     pub inputs: Vec<String>,
     pub outputs: Vec<String>,
-    /// Row-major matrices: A (2s × 2s), B (2s × ni), C (no × 2s), D (no × ni).
+    /// A (ns × ns), B (ns × ni), C (no × ns), D (no × ni), ns = 2s + nx.
     pub a: Mat<f64>,
     pub b: Mat<f64>,
     pub c: Mat<f64>,
     pub d: Mat<f64>,
-    /// Values of the states S and W at the operating point.
+    /// Values of the states (S, W, X) at the operating point.
     pub x: Vec<f64>,
 }
 
@@ -37,6 +37,9 @@ struct Blocks {
     /// Independent constraint rows (m minus the redundant ones): 34d–e have this many.
     mr: usize,
     s: usize,
+    /// Differential states X and user unknowns Z = (X, Ẋ, V).
+    nx: usize,
+    nz: usize,
 }
 
 impl Blocks {
@@ -67,10 +70,14 @@ impl Blocks {
     fn sv(&self) -> usize {
         4 * self.n + 3 * self.s + self.m
     }
-    fn dim(&self) -> usize {
+    fn z(&self) -> usize {
         4 * self.n + 4 * self.s + self.m
     }
-    // Rows: 34a n, 34b n, 34c m (redundant rows: λ = 0), 34d mr, 34e mr, 34f..34k s each.
+    fn dim(&self) -> usize {
+        4 * self.n + 4 * self.s + self.m + self.nz
+    }
+    // Rows: 34a n, 34b n, 34c m (redundant rows: λ = 0), 34d mr, 34e mr, 34f..34k s each,
+    // then the user rows r = 0 (nz − nx, Eq. 7a–7b) and X = X̄ (nx).
     fn row(&self, eq: char) -> usize {
         let (n, m, mr, s) = (self.n, self.m, self.mr, self.s);
         let f = 2 * n + m + 2 * mr;
@@ -85,7 +92,9 @@ impl Blocks {
             'h' => f + 2 * s,
             'i' => f + 3 * s,
             'j' => f + 4 * s,
-            _ => f + 5 * s,
+            'k' => f + 5 * s,
+            'l' => f + 6 * s,
+            _ => f + 6 * s + self.nz - self.nx,
         }
     }
 }
@@ -152,7 +161,8 @@ fn check_partition(
 pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result<Linearization, EngineError> {
     let (udot, lam) = sim.accelerations()?;
     let t = sim.time();
-    let inputs = sim.inputs();
+    let ext = sim.ext();
+    let inputs = &ext[..];
     let (q, u) = (sim.q().to_vec(), sim.u().to_vec());
     let sys = sim.system();
     let (n, m, s) = (sys.n(), sys.m, sel.states.len());
@@ -170,26 +180,31 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
             "{s} linearization states do not complete {mr} independent constraints to {n} coordinates"
         )));
     }
-    check_partition(sys, sel, &q, t, &inputs)?;
-    let bl = Blocks { n, m, mr, s };
+    check_partition(sys, sel, &q, t, inputs)?;
+    let lay = Layout::of(sys);
+    let (nx, nz, ni) = (lay.nx, lay.nz(), sys.ni());
+    let bl = Blocks { n, m, mr, s, nx, nz };
     let mut k = Triplets::new();
     // Eq. 34a, 34b, 34d, 34e from the integrator's exact Jacobian of
     // f = [Hu; Q − Pᵀλ; C; Ċ] at μ = 0.
-    let lay = Layout { n, m };
     let mut y = vec![0.0; lay.dim()];
     y[..n].copy_from_slice(&q);
     y[n..2 * n].copy_from_slice(&u);
-    y[2 * n..2 * n + m].copy_from_slice(&lam);
+    y[lay.z()..lay.z() + nz].copy_from_slice(&ext[ni..]);
+    y[lay.lam()..lay.lam() + m].copy_from_slice(&lam);
     let mut jac = Triplets::new();
-    jacobian(sys, lay, t, &y, &inputs, &mut jac);
+    jacobian(sys, lay, t, &y, &inputs[..ni], &mut jac);
+    let (lz, ll, lm) = (lay.z(), lay.lam(), lay.mu());
     for (p, &v) in jac.idx.iter().zip(&jac.vals) {
         let (r, c) = (p.row, p.col);
         let col = if c < n {
             bl.q() + c
         } else if c < 2 * n {
             bl.u() + c - n
-        } else if c < 2 * n + m {
-            bl.lam() + c - 2 * n
+        } else if c < ll {
+            bl.z() + c - lz
+        } else if c < lm {
+            bl.lam() + c - ll
         } else {
             continue; // μ does not appear in Eq. 34
         };
@@ -197,13 +212,20 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
             k.push(bl.row('b') + r, col, -v); // 34b: q̇ − H(q)u
         } else if r < 2 * n {
             k.push(bl.row('a') + r - n, col, -v); // 34a: M u̇ − (Q − Pᵀλ)
-        } else if r < 2 * n + m {
-            if let Some(cr) = cmap[r - 2 * n] {
+        } else if r < lz + nx {
+            continue; // X' = Ẋ: the rate of X is the unknown Ẋ itself
+        } else if r < ll {
+            k.push(bl.row('l') + r - lz - nx, col, v); // Eq. 7a–7b: r(q, u, Z, v, t) = 0
+        } else if r < lm {
+            if let Some(cr) = cmap[r - ll] {
                 k.push(bl.row('e') + cr, col, v); // 34e: C
             }
-        } else if let Some(cr) = cmap[r - 2 * n - m] {
+        } else if let Some(cr) = cmap[r - lm] {
             k.push(bl.row('d') + cr, col, v); // 34d: Ċ
         }
+    }
+    for i in 0..nx {
+        k.push(bl.row('x') + i, bl.z() + i, 1.0); // X = X̄
     }
     for i in 0..n {
         k.push(bl.row('b') + i, bl.qd() + i, 1.0);
@@ -232,7 +254,7 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
         }
     };
     for el in &sys.constraints {
-        for (e, jet) in jets(sys, el, &q, &u, &udot, t, &inputs).iter().enumerate() {
+        for (e, jet) in jets(sys, el, &q, &u, &udot, t, inputs).iter().enumerate() {
             if sys.redundant[el.row + e] {
                 k.push(bl.row('c') + el.row + e, bl.lam() + el.row + e, 1.0); // its λ = 0
             } else {
@@ -241,9 +263,11 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
         }
     }
     // Eq. 34f–34k for each selected state.
-    let mut x = vec![0.0; 2 * s];
+    let ns = 2 * s + nx;
+    let mut x = vec![0.0; ns];
+    x[2 * s..].copy_from_slice(&ext[ni..ni + nx]);
     for (i, st) in sel.states.iter().enumerate() {
-        let jet = &jets(sys, st, &q, &u, &udot, t, &inputs)[0];
+        let jet = &jets(sys, st, &q, &u, &udot, t, inputs)[0];
         x[i] = jet.g;
         x[s + i] = jet.g1;
         k.push(bl.row('f') + i, bl.sv() + i, 1.0);
@@ -257,18 +281,29 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
         k.push(bl.row('j') + i, bl.w() + i, 1.0);
         k.push(bl.row('k') + i, bl.sv() + i, 1.0);
     }
-    // Right-hand sides: ∂/∂S̄ (34k), ∂/∂W̄ (34j), ∂/∂v (34a: +∂Q/∂v).
-    let ni = inputs.len();
+    // Right-hand sides: ∂/∂S̄ (34k), ∂/∂W̄ (34j), ∂/∂X̄, ∂/∂v (34a: +∂Q/∂v; user rows: −∂r/∂v).
     let dim = bl.dim();
-    let mut rhs = Mat::<f64>::zeros(dim, 2 * s + ni);
+    let mut rhs = Mat::<f64>::zeros(dim, ns + ni);
     for i in 0..s {
         rhs[(bl.row('k') + i, i)] = 1.0;
         rhs[(bl.row('j') + i, s + i)] = 1.0;
     }
+    for i in 0..nx {
+        rhs[(bl.row('x') + i, 2 * s + i)] = 1.0;
+    }
     for el in &sys.forces {
-        for (v, col) in force_input_jacobian(sys, el, &q, &u, t, &inputs).iter().enumerate() {
-            for (a, &val) in col.iter().enumerate() {
-                rhs[(bl.row('a') + NQ * el.bodies[a / NQ] + a % NQ, 2 * s + v)] += val;
+        for (v, col) in force_ext_jacobian(sys, el, &q, &u, t, inputs) {
+            if v < ni {
+                for (a, &val) in col.iter().enumerate() {
+                    rhs[(bl.row('a') + NQ * el.bodies[a / NQ] + a % NQ, ns + v)] += val;
+                }
+            }
+        }
+    }
+    for (r, ue) in sys.user.iter().enumerate() {
+        for (v, val) in user_jacobian(sys, ue, &q, &u, t, inputs).dext {
+            if v < ni {
+                rhs[(bl.row('l') + r, ns + v)] -= val;
             }
         }
     }
@@ -284,16 +319,24 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
     if !lu.solve_parallel(rhs.as_mut(), threads) {
         return Err(singular());
     }
-    // A and B: rows Ṡ, Ẇ of the solution.
-    let pick = |r: usize, c: usize| if r < s { rhs[(bl.sd() + r, c)] } else { rhs[(bl.wd() + r - s, c)] };
-    let a = Mat::from_fn(2 * s, 2 * s, pick);
-    let b = Mat::from_fn(2 * s, ni, |r, c| pick(r, 2 * s + c));
+    // A and B: rows Ṡ, Ẇ, Ẋ of the solution.
+    let pick = |r: usize, c: usize| {
+        if r < s {
+            rhs[(bl.sd() + r, c)]
+        } else if r < 2 * s {
+            rhs[(bl.wd() + r - s, c)]
+        } else {
+            rhs[(bl.z() + nx + r - 2 * s, c)]
+        }
+    };
+    let a = Mat::from_fn(ns, ns, pick);
+    let b = Mat::from_fn(ns, ni, |r, c| pick(r, ns + c));
     // C and D: chain rule through q, u, u̇ sensitivities.
     let no = sys.outputs.len();
-    let mut c = Mat::<f64>::zeros(no, 2 * s);
+    let mut c = Mat::<f64>::zeros(no, ns);
     let mut d = Mat::<f64>::zeros(no, ni);
     for (o, (e, &abase)) in sys.outputs.iter().zip(&sys.output_bases).enumerate() {
-        let g = output_gradient(sys, e, abase, &q, &u, &udot, t, &inputs);
+        let g = output_gradient(sys, e, abase, &q, &u, &udot, t, inputs);
         let nql = NQ * g.bodies.len();
         let sens = |col: usize| -> f64 {
             let mut v = 0.0;
@@ -303,15 +346,20 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
                     + g.dz[nql + a] * rhs[(bl.u() + gi, col)]
                     + g.dz[2 * nql + a] * rhs[(bl.ud() + gi, col)];
             }
+            for (zi, &dy) in g.dv[ni..].iter().enumerate() {
+                if dy != 0.0 {
+                    v += dy * rhs[(bl.z() + zi, col)];
+                }
+            }
             v
         };
-        for col in 0..2 * s {
+        for col in 0..ns {
             c[(o, col)] = sens(col);
         }
         for v in 0..ni {
-            d[(o, v)] = sens(2 * s + v) + g.dv[v];
+            d[(o, v)] = sens(ns + v) + g.dv[v];
         }
-        if (0..2 * s).any(|col| !c[(o, col)].is_finite()) || (0..ni).any(|v| !d[(o, v)].is_finite()) {
+        if (0..ns).any(|col| !c[(o, col)].is_finite()) || (0..ni).any(|v| !d[(o, v)].is_finite()) {
             return Err(EngineError::Numeric(format!(
                 "output '{}' has no finite derivative here (e.g. |v| at v = 0, or element loads, which are not differentiated yet)",
                 sys.output_names[o]
@@ -320,6 +368,7 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
     }
     let mut states: Vec<String> = sel.states.iter().map(|s| s.name.clone()).collect();
     states.extend(sel.states.iter().map(|s| format!("der({})", s.name)));
+    states.extend(sys.user.iter().take(nx).map(|u| u.name.clone()));
     Ok(Linearization {
         time: t,
         states,

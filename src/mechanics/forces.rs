@@ -24,6 +24,9 @@ pub enum ForceKind {
         torque: Box<[Expr; 3]>,
         abase: [usize; 6],
     },
+    /// Linear six-component spring-damper in marker j's axes: translation of i's origin
+    /// relative to j's, small-angle rotation vector of i relative to j, and their rates.
+    Bushing { i: MarkerId, j: MarkerId, k: [f64; 6], c: [f64; 6] },
 }
 
 /// A force element and the bodies its value depends on or acts on.
@@ -32,6 +35,8 @@ pub struct ForceEl {
     pub name: String,
     pub kind: ForceKind,
     pub bodies: Vec<usize>,
+    /// Entries of the external values (inputs, user unknowns) its expressions read.
+    pub ext_refs: Vec<usize>,
     /// Reference for unwrapping the rotational angle az(i, j) (kept near it).
     pub angle_ref: f64,
 }
@@ -95,6 +100,7 @@ impl ForceEl {
                 let t = to_ground(V3([ev(3), ev(4), ev(5)]));
                 Load { force: f, torque: t }
             }
+            ForceKind::Bushing { i, j, k, c } => bushing_load(ctx, *i, *j, k, c),
         }
     }
 
@@ -103,6 +109,7 @@ impl ForceEl {
         match &self.kind {
             ForceKind::SpringDamper { i, j, .. } | ForceKind::Sforce { i, j, .. } => (*i, Some(*j)),
             ForceKind::Gforce { i, j, .. } => (*i, *j),
+            ForceKind::Bushing { i, j, .. } => (*i, Some(*j)),
         }
     }
 
@@ -131,6 +138,24 @@ impl ForceEl {
             _ => 0.0,
         }
     }
+}
+
+/// Bushing load on i (ground axes): in j's axes F = −K d − C ḋ, τ = −K_r θ − C_r ω with
+/// d = R_jᵀ(p_i − p_j), ḋ = R_jᵀ(ṗ_i − ṗ_j), θ = vee(skew(R_jᵀR_i)) (= the rotation vector
+/// to first order) and ω = R_jᵀ(ω_i − ω_j).
+fn bushing_load<T: Real>(ctx: &LocalCtx<T>, i: MarkerId, j: MarkerId, k: &[f64; 6], c: &[f64; 6]) -> Load<T> {
+    let (pi, pj) = (ctx.pose(i), ctx.pose(j));
+    let (ti, tj) = (ctx.twist(i), ctx.twist(j));
+    let d = pj.r.tv(&(pi.p - pj.p));
+    let dd = pj.r.tv(&(ti.v - tj.v));
+    let r = pj.r.t().mm(&pi.r);
+    let half = T::cst(0.5);
+    let th = V3([(r.0[2][1] - r.0[1][2]) * half, (r.0[0][2] - r.0[2][0]) * half, (r.0[1][0] - r.0[0][1]) * half]);
+    let w = pj.r.tv(&(ti.w - tj.w));
+    let comp = |x: &V3<T>, xd: &V3<T>, o: usize| {
+        V3(std::array::from_fn(|a| -T::cst(k[o + a]) * x.0[a] - T::cst(c[o + a]) * xd.0[a]))
+    };
+    Load { force: pj.r.mv(&comp(&d, &dd, 0)), torque: pj.r.mv(&comp(&th, &w, 3)) }
 }
 
 /// Distance |p_i − p_j| and its rate.

@@ -7,6 +7,7 @@ use super::constraints::ConstraintEl;
 use super::forces::ForceEl;
 use super::local::LocalCtx;
 use super::system::System;
+use super::user::UserEq;
 use crate::ad::{Dual, Real};
 
 /// Most bodies one element may touch.
@@ -167,20 +168,75 @@ pub fn gyroscopic(j: &[[f64; 3]; 3], w: &[f64]) -> ([f64; 3], [f64; 9]) {
     (g.val(), std::array::from_fn(|i| g.0[i / 3].d[i % 3]))
 }
 
-/// ∂Q/∂v of one force element for every input v: `ni` columns of 6nb entries.
-pub fn force_input_jacobian(sys: &System, el: &ForceEl, q: &[f64], u: &[f64], t: f64, inputs: &[f64]) -> Vec<Vec<f64>> {
+/// ∂Q/∂w of one force element for each external value w it reads (inputs and user
+/// unknowns, see [`System::ext`]): (index into `ext`, 6nb entries).
+pub fn force_ext_jacobian(
+    sys: &System,
+    el: &ForceEl,
+    q: &[f64],
+    u: &[f64],
+    t: f64,
+    ext: &[f64],
+) -> Vec<(usize, Vec<f64>)> {
     let (ql, ul) = (gather(&el.bodies, q), gather(&el.bodies, u));
-    let lift = |x: &[f64]| -> Vec<Dual<f64, 1>> { x.iter().map(|&v| Dual::cst(v)).collect() };
-    (0..inputs.len())
-        .map(|k| {
+    el.ext_refs
+        .iter()
+        .map(|&k| {
             let (qd, ud) = (lift(&ql), lift(&ul));
-            let mut ctx = LocalCtx::new(sys, &el.bodies, &qd, &ud, &[], Dual::cst(t), inputs);
-            ctx.input_values = Some(
-                inputs.iter().enumerate().map(|(i, &v)| if i == k { Dual::var(v, 0) } else { Dual::cst(v) }).collect(),
-            );
+            let mut ctx = LocalCtx::new(sys, &el.bodies, &qd, &ud, &[], Dual::cst(t), ext);
+            ctx.input_values = Some(seed_ext(ext, k));
             let mut out = vec![Dual::zero(); NQ * el.bodies.len()];
             el.generalized(&ctx, &mut out);
-            out.iter().map(|e| e.d[0]).collect()
+            (k, out.iter().map(|e| e.d[0]).collect())
         })
         .collect()
+}
+
+/// Constants as dual numbers.
+fn lift(x: &[f64]) -> Vec<Dual<f64, 1>> {
+    x.iter().map(|&v| Dual::cst(v)).collect()
+}
+
+/// External values with entry `k` seeded.
+fn seed_ext(ext: &[f64], k: usize) -> Vec<Dual<f64, 1>> {
+    ext.iter().enumerate().map(|(i, &v)| if i == k { Dual::var(v, 0) } else { Dual::cst(v) }).collect()
+}
+
+/// Residual of a user row (Eq. 7a–7b).
+pub fn user_residual(sys: &System, ue: &UserEq, q: &[f64], u: &[f64], t: f64, ext: &[f64]) -> f64 {
+    let (ql, ul) = (gather(&ue.bodies, q), gather(&ue.bodies, u));
+    ue.residual(&LocalCtx::new(sys, &ue.bodies, &ql, &ul, &[], t, ext))
+}
+
+/// Exact derivatives of a user row: ∂r/∂(local q, local u) (12nb) and ∂r/∂w for each
+/// external value it reads.
+pub struct UserJacobian {
+    pub value: f64,
+    pub dqu: Vec<f64>,
+    pub dext: Vec<(usize, f64)>,
+}
+
+/// Value and exact derivatives of a user row.
+pub fn user_jacobian(sys: &System, ue: &UserEq, q: &[f64], u: &[f64], t: f64, ext: &[f64]) -> UserJacobian {
+    let (value, dqu) = by_bodies!(ue.bodies.len(), user_qu_k, 12, 24, 36, 48, 1(sys, ue, q, u, t, ext));
+    let (ql, ul) = (gather(&ue.bodies, q), gather(&ue.bodies, u));
+    let dext = ue
+        .ext_refs
+        .iter()
+        .map(|&k| {
+            let (qd, ud) = (lift(&ql), lift(&ul));
+            let mut ctx = LocalCtx::new(sys, &ue.bodies, &qd, &ud, &[], Dual::cst(t), ext);
+            ctx.input_values = Some(seed_ext(ext, k));
+            (k, ue.residual(&ctx).d[0])
+        })
+        .collect();
+    UserJacobian { value, dqu, dext }
+}
+
+fn user_qu_k<const K: usize>(sys: &System, ue: &UserEq, q: &[f64], u: &[f64], t: f64, ext: &[f64]) -> (f64, Vec<f64>) {
+    let nq = NQ * ue.bodies.len();
+    let ql: Vec<Dual<f64, K>> = gather(&ue.bodies, q).iter().enumerate().map(|(k, &v)| Dual::var(v, k)).collect();
+    let ul: Vec<Dual<f64, K>> = gather(&ue.bodies, u).iter().enumerate().map(|(k, &v)| Dual::var(v, nq + k)).collect();
+    let r = ue.residual(&LocalCtx::new(sys, &ue.bodies, &ql, &ul, &[], Dual::cst(t), ext));
+    (r.v, r.d[..2 * nq].to_vec())
 }

@@ -33,6 +33,8 @@ pub struct LocalCtx<'a, T: Real> {
     pub ids: &'a [usize],
     pub bodies: Vec<LocalBody<T>>,
     pub t: T,
+    /// External values `ext` = [inputs; user unknowns Z = (X, dX/dt, V)] (see
+    /// [`System::ext`]); a shorter slice (inputs only) reads user unknowns as NaN.
     pub inputs: &'a [f64],
     /// Element loads for `fx(...)` (outputs only); `None` reads as NaN.
     pub loads: Option<&'a dyn Fn(LoadFn, ElementRef) -> f64>,
@@ -40,7 +42,8 @@ pub struct LocalCtx<'a, T: Real> {
     angle_base: Cell<usize>,
     /// When set, every unwrapped angle is recorded as (global slot, value).
     pub record: Option<&'a RefCell<Vec<(usize, f64)>>>,
-    /// When set, inputs read these (e.g. seeded dual numbers) instead of `inputs`.
+    /// When set, inputs and user unknowns read these (e.g. seeded dual numbers, same
+    /// layout as `inputs`) instead of `inputs`.
     pub input_values: Option<Vec<T>>,
 }
 
@@ -88,6 +91,14 @@ impl<'a, T: Real> LocalCtx<'a, T> {
         self.sys.markers[m].body.map(|b| &self.bodies[self.local(b)])
     }
 
+    /// Entry `k` of the external values (NaN beyond the slice).
+    pub fn ext_value(&self, k: usize) -> T {
+        match &self.input_values {
+            Some(v) => v.get(k).copied().unwrap_or(T::cst(f64::NAN)),
+            None => T::cst(self.inputs.get(k).copied().unwrap_or(f64::NAN)),
+        }
+    }
+
     /// Offset of marker `m` from its body's CM, body axes.
     fn offset(&self, m: MarkerId) -> V3<T> {
         V3::cst(self.sys.markers[m].s)
@@ -102,19 +113,16 @@ impl<T: Real> ExprEnv<T> for LocalCtx<'_, T> {
         T::cst(self.sys.params[i])
     }
     fn input(&self, i: usize) -> T {
-        match &self.input_values {
-            Some(v) => v[i],
-            None => T::cst(self.inputs[i]),
-        }
+        self.ext_value(i)
     }
-    fn variable(&self, _i: usize) -> T {
-        T::cst(f64::NAN)
+    fn variable(&self, i: usize) -> T {
+        self.ext_value(self.sys.ext_variable(i))
     }
-    fn diff(&self, _i: usize) -> T {
-        T::cst(f64::NAN)
+    fn diff(&self, i: usize) -> T {
+        self.ext_value(self.sys.ext_diff(i))
     }
-    fn diff_dot(&self, _i: usize) -> T {
-        T::cst(f64::NAN)
+    fn diff_dot(&self, i: usize) -> T {
+        self.ext_value(self.sys.ext_diff_dot(i))
     }
     fn pose(&self, m: MarkerId) -> Pose<T> {
         let g = &self.sys.markers[m];

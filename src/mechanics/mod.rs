@@ -9,5 +9,6 @@ pub mod forces;
 pub mod kernels;
 pub mod local;
 pub mod system;
+pub mod user;
 
 pub use system::{MarkerGeom, System};

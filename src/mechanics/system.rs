@@ -9,6 +9,7 @@ use super::body::NQ;
 use super::constraints::{ConstraintEl, ConstraintKind, VelocityIc};
 use super::forces::{ForceEl, ForceKind};
 use super::kernels::MAX_ELEMENT_BODIES;
+use super::user::{UserEq, UserKind, ext_refs};
 use crate::geom::{M3, rot_x};
 use crate::model::expr::{ElementRef, Expr, angle_count, deps};
 use crate::model::{Model, MotionDof, Orientation};
@@ -52,12 +53,20 @@ pub struct System {
     /// Exact velocity initial conditions.
     pub ic_velocities: Vec<VelocityIc>,
     pub forces: Vec<ForceEl>,
+    /// User rows (differentials, then variables; seed Eq. 7a–7b).
+    pub user: Vec<UserEq>,
+    /// Number of differential states X and of variables V.
+    pub nx: usize,
+    pub nv: usize,
+    /// Start values of X.
+    pub x_init: Vec<f64>,
     /// Where motions and user constraints start in `constraints` (joints come first),
     /// and sforces and gforces in `forces` (spring-dampers first).
     first_motion: usize,
     first_user_constraint: usize,
     first_sforce: usize,
     first_gforce: usize,
+    first_bushing: usize,
     pub output_names: Vec<String>,
     pub input_names: Vec<String>,
     pub outputs: Vec<Expr>,
@@ -218,6 +227,8 @@ impl System {
         }
         let m = constraints.iter().map(|c| c.neq).sum();
 
+        let (ni, nx) = (model.inputs.len(), model.differentials.len());
+        let refs = |es: &[&Expr]| ext_refs(ni, nx, es);
         let mut forces = Vec::new();
         for s in &model.spring_dampers {
             let kind = ForceKind::SpringDamper {
@@ -229,7 +240,13 @@ impl System {
                 length: s.length.value,
                 preload: s.preload.value,
             };
-            forces.push(ForceEl { name: s.name.clone(), kind, bodies: bodies_of(&[s.i, s.j], &[]), angle_ref: 0.0 });
+            forces.push(ForceEl {
+                name: s.name.clone(),
+                kind,
+                bodies: bodies_of(&[s.i, s.j], &[]),
+                ext_refs: vec![],
+                angle_ref: 0.0,
+            });
         }
         for s in &model.sforces {
             let kind =
@@ -238,6 +255,7 @@ impl System {
                 name: s.name.clone(),
                 kind,
                 bodies: bodies_of(&[s.i, s.j], &[&s.function]),
+                ext_refs: refs(&[&s.function]),
                 angle_ref: 0.0,
             });
         }
@@ -255,7 +273,53 @@ impl System {
                 torque: Box::new(g.torque.clone()),
                 abase,
             };
-            forces.push(ForceEl { name: g.name.clone(), kind, bodies: bodies_of(&ms, &exprs), angle_ref: 0.0 });
+            forces.push(ForceEl {
+                name: g.name.clone(),
+                kind,
+                bodies: bodies_of(&ms, &exprs),
+                ext_refs: refs(&exprs),
+                angle_ref: 0.0,
+            });
+        }
+        for b in &model.bushings {
+            let six = |v: Option<&crate::model::NumVec>| -> [f64; 6] {
+                let x = v.map(|v| v.values()).unwrap_or_default();
+                std::array::from_fn(|a| x.get(a).copied().unwrap_or(0.0))
+            };
+            let kind = ForceKind::Bushing { i: b.i, j: b.j, k: six(Some(&b.stiffness)), c: six(b.damping.as_ref()) };
+            let bodies = bodies_of(&[b.i, b.j], &[]);
+            forces.push(ForceEl { name: b.name.clone(), kind, bodies, ext_refs: vec![], angle_ref: 0.0 });
+        }
+        let mut user = Vec::new();
+        for (k, d) in model.differentials.iter().enumerate() {
+            let kind = if d.implicit { UserKind::Implicit } else { UserKind::Explicit };
+            let mut r = refs(&[&d.function]);
+            let own = ni + nx + k;
+            if kind == UserKind::Explicit && !r.contains(&own) {
+                r.push(own);
+                r.sort_unstable();
+            }
+            let (f, bodies, abase) = (d.function.clone(), bodies_of(&[], &[&d.function]), alloc(&d.function));
+            user.push(UserEq { name: d.name.clone(), kind, f, abase, bodies, ext_refs: r, own });
+        }
+        for (k, v) in model.variables.iter().enumerate() {
+            let mut r = refs(&[&v.function]);
+            let own = ni + 2 * nx + k;
+            if !r.contains(&own) {
+                r.push(own);
+                r.sort_unstable();
+            }
+            let (f, bodies, abase) = (v.function.clone(), bodies_of(&[], &[&v.function]), alloc(&v.function));
+            user.push(UserEq { name: v.name.clone(), kind: UserKind::Variable, f, abase, bodies, ext_refs: r, own });
+        }
+        for u in &user {
+            if u.bodies.len() > MAX_ELEMENT_BODIES {
+                return Err(format!(
+                    "'{}' reads {} bodies (at most {MAX_ELEMENT_BODIES}); split it into variables",
+                    u.name,
+                    u.bodies.len()
+                ));
+            }
         }
         for c in &constraints {
             if c.bodies.len() > MAX_ELEMENT_BODIES {
@@ -285,6 +349,11 @@ impl System {
             first_user_constraint: model.joints.len() + model.motions.len(),
             first_sforce: model.spring_dampers.len(),
             first_gforce: model.spring_dampers.len() + model.sforces.len(),
+            first_bushing: model.spring_dampers.len() + model.sforces.len() + model.gforces.len(),
+            user,
+            nx,
+            nv: model.variables.len(),
+            x_init: model.differentials.iter().map(|d| d.start.value).collect(),
             constraints,
             m,
             redundant: vec![false; m],
@@ -315,6 +384,7 @@ impl System {
             ElementRef::SpringDamper(k) => ElementSlot::Force(k),
             ElementRef::Sforce(k) => ElementSlot::Force(self.first_sforce + k),
             ElementRef::Gforce(k) => ElementSlot::Force(self.first_gforce + k),
+            ElementRef::Bushing(k) => ElementSlot::Force(self.first_bushing + k),
         }
     }
 

@@ -187,6 +187,38 @@ pub struct Gforce {
     pub pos: SrcPos,
 }
 
+/// `<bushing>`: linear six-component spring-damper in marker j's axes (small angles).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Bushing {
+    pub name: String,
+    pub i: MarkerId,
+    pub j: MarkerId,
+    /// kx ky kz krx kry krz.
+    pub stiffness: NumVec,
+    /// cx cy cz crx cry crz (zeros when absent).
+    pub damping: Option<NumVec>,
+    pub pos: SrcPos,
+}
+
+/// `<variable>`: a user variable V = function (seed Eq. 7b).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Variable {
+    pub name: String,
+    pub function: Expr,
+    pub pos: SrcPos,
+}
+
+/// `<differential>`: dX/dt = function, or function = 0 with `dif1(X)` = dX/dt when
+/// `implicit` (seed Eq. 7a).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Differential {
+    pub name: String,
+    pub start: Num,
+    pub function: Expr,
+    pub implicit: bool,
+    pub pos: SrcPos,
+}
+
 /// `<input>`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Input {

@@ -105,6 +105,7 @@ pub enum ElementRef {
     SpringDamper(usize),
     Sforce(usize),
     Gforce(usize),
+    Bushing(usize),
 }
 
 /// An expression node.

@@ -50,6 +50,7 @@ fn element_key(r: ElementRef) -> (u8, usize) {
         ElementRef::SpringDamper(i) => (3, i),
         ElementRef::Sforce(i) => (4, i),
         ElementRef::Gforce(i) => (5, i),
+        ElementRef::Bushing(i) => (6, i),
     }
 }
 

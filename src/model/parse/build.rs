@@ -6,7 +6,7 @@ use super::load::Loader;
 use super::orient::read_orientation;
 use super::validate::{Allowed, check_deps, check_inertia, check_mass};
 use super::xml::XElem;
-use crate::model::expr::{MarkerId, Scope};
+use crate::model::expr::{self, MarkerId, Scope};
 use crate::model::*;
 
 const SPRING_TYPES: &[(&str, SpringType)] =
@@ -73,6 +73,40 @@ impl<'a> Loader<'a> {
                         frame: opt_marker_ref(&el, "frame")?,
                         force,
                         torque,
+                        pos: x.pos,
+                    });
+                }
+                "bushing" => {
+                    let (i, j) = (marker_ref(&el, "i")?, marker_ref(&el, "j")?);
+                    self.check_bodies(&el, i, j)?;
+                    self.model.bushings.push(Bushing {
+                        name: x.label().into(),
+                        i,
+                        j,
+                        stiffness: el.num_vec("stiffness", &[6])?.ok_or_else(|| el.err("missing 'stiffness'"))?,
+                        damping: el.num_vec("damping", &[6])?,
+                        pos: x.pos,
+                    });
+                }
+                "variable" => {
+                    let function = el.expr_req("function")?;
+                    check_deps(&el, "function", &function, Allowed::Force)?;
+                    self.model.variables.push(Variable { name: x.label().into(), function, pos: x.pos });
+                }
+                "differential" => {
+                    let function = el.expr_req("function")?;
+                    check_deps(&el, "function", &function, Allowed::Force)?;
+                    let implicit = el.keyword("implicit", &[("true", true), ("false", false)])?.unwrap_or(false);
+                    let me = self.model.differentials.len();
+                    if implicit && !expr::deps(&function).diff_dots.contains(&me) {
+                        let at = el.get("function").map_or(x.pos, |a| a.pos);
+                        return Err(el.err_at(at, format!("implicit: 'function' must use dif1({})", x.label())));
+                    }
+                    self.model.differentials.push(Differential {
+                        name: x.label().into(),
+                        start: el.num_or("start", 0.0)?,
+                        function,
+                        implicit,
                         pos: x.pos,
                     });
                 }

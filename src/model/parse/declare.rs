@@ -9,8 +9,7 @@ use crate::model::ModelError;
 use crate::model::expr::{ElementRef, NameRef};
 
 /// Elements of the format that this version does not read yet.
-const UNSUPPORTED: &[&str] =
-    &["differential", "variable", "bushing", "rolling_wheel", "knife_edge", "velocity_constraint"];
+const UNSUPPORTED: &[&str] = &["rolling_wheel", "knife_edge", "velocity_constraint"];
 
 /// Allowed and required attributes of each supported element.
 pub(crate) fn schema(tag: &str) -> Option<(&'static [&'static str], &'static [&'static str])> {
@@ -36,6 +35,9 @@ pub(crate) fn schema(tag: &str) -> Option<(&'static [&'static str], &'static [&'
         ),
         "sforce" => (&["name", "type", "i", "j", "function"], &["name", "type", "i", "j", "function"]),
         "gforce" => (&["name", "i", "j", "frame", "force", "torque"], &["name", "i"]),
+        "bushing" => (&["name", "i", "j", "stiffness", "damping"], &["name", "i", "j", "stiffness"]),
+        "variable" => (&["name", "function"], &["name", "function"]),
+        "differential" => (&["name", "start", "function", "implicit"], &["name", "function"]),
         "input" => (&["name", "start", "unit"], &["name"]),
         "output" => (&["name", "function", "unit"], &["name", "function"]),
         "experiment" => (&["start", "stop", "step", "tolerance"], &[]),
@@ -72,6 +74,9 @@ impl<'a> Loader<'a> {
                 "spring_damper",
                 "sforce",
                 "gforce",
+                "bushing",
+                "variable",
+                "differential",
                 "input",
                 "output",
                 "linearization",
@@ -251,6 +256,19 @@ impl<'a> Loader<'a> {
                     n.gforces += 1;
                     n.forces += 1;
                 }
+                "bushing" => {
+                    self.declare_element(x, "force", ElementRef::Bushing(n.bushings), n.forces)?;
+                    n.bushings += 1;
+                    n.forces += 1;
+                }
+                "variable" => {
+                    self.declare_bare(x, "variable", NameRef::Variable(n.variables))?;
+                    n.variables += 1;
+                }
+                "differential" => {
+                    self.declare_bare(x, "differential", NameRef::Diff(n.diffs))?;
+                    n.diffs += 1;
+                }
                 "output" => {
                     let mut ns = std::mem::take(&mut self.ns_outputs);
                     let res = self.declare(&mut ns, x, "output", n.outputs, false);
@@ -302,6 +320,9 @@ struct Counts {
     springs: usize,
     sforces: usize,
     gforces: usize,
+    bushings: usize,
+    variables: usize,
+    diffs: usize,
     forces: usize,
     outputs: usize,
     lin: usize,
