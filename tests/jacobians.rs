@@ -44,6 +44,10 @@ const KITCHEN_SINK: &str = r#"<multibody name="sink" version="1">
   <gforce name="g1" i="a.m2" j="b.m1" frame="c.m1" force="vx(a.m2, b.m1)*2, -dy(a.m2), 1+time" torque="wz(a.m2)*0.5, 0.2, -dz(b.cm, a.cm, c.m1)"/>
   <gforce name="g2" i="c.m1" force="0 0 3" torque="0.1*wx(c.cm) 0 0"/>
   <bushing name="bu" i="a.m2" j="b.m1" stiffness="10 20 30 4 5 6" damping="0.1 0.2 0.3 0.04 0.05 0.06"/>
+  <rolling_wheel name="wheel" marker="a.m2" radius="0.35"/>
+  <rolling_wheel name="wheel2" marker="b.m2" radius="0.2" plane="c.m1"/>
+  <knife_edge name="knife" marker="b.m1"/>
+  <velocity_constraint name="vc" function="vx(c.cm)*dy(a.cm) + 0.3*wz(c.cm, b.cm, a.m1) - 0.2*sin(time)"/>
   <input name="v"/>
   <variable name="loop1" function="0.3*loop2 + dx(a.m1, b.cm) + v*xi"/>
   <variable name="loop2" function="-0.2*loop1^2 + sin(xi) + wz(c.cm)"/>
@@ -76,8 +80,8 @@ fn setup() -> (System, Layout, Vec<f64>) {
     for i in 0..lay.nz() {
         y[lay.z() + i] = rng(&mut seed);
     }
-    for i in 0..lay.m {
-        y[lay.lam() + i] = 3.0 * rng(&mut seed);
+    for i in 0..lay.m + lay.mn {
+        y[lay.lam() + i] = 3.0 * rng(&mut seed); // λ then ν
     }
     (sys, lay, y)
 }
@@ -163,5 +167,36 @@ fn acceleration_right_hand_side_is_the_second_time_derivative_of_the_constraints
             let fd = (cp[r] - cm[r]) / (2.0 * h);
             assert!((fd - want).abs() < 1e-6 * want.abs().max(1.0), "{} eq {e}: fd {fd} vs {want}", el.name);
         }
+    }
+}
+
+#[test]
+fn nonholonomic_acceleration_right_hand_side_is_the_time_derivative_of_g() {
+    // ġ = B u̇ + γ_nh along q' = H(q)u, u' = a, t' = 1: central differences of g over ±h
+    // against B a + γ_nh (h = 1e-5, tolerance as above).
+    use mbfmu::dae::equations::{nonholonomic_b, nonholonomic_gamma};
+    let (sys, lay, y) = setup();
+    assert_eq!(sys.mn, 6);
+    let t = 0.43;
+    let (q, u) = (&y[..lay.n], &y[lay.u()..lay.u() + lay.n]);
+    let ext = lay.ext(&INPUTS, &y);
+    let mut seed = 5;
+    let a: Vec<f64> = (0..lay.n).map(|_| rng(&mut seed)).collect();
+    let qd: Vec<f64> = (0..sys.nb()).flat_map(|b| qdot(&q[NQ * b..NQ * b + NQ], &u[NQ * b..NQ * b + NQ])).collect();
+    let h = 1e-5;
+    let at = |s: f64| -> Vec<f64> {
+        let qs: Vec<f64> = (0..lay.n).map(|i| q[i] + s * qd[i]).collect();
+        let us: Vec<f64> = (0..lay.n).map(|i| u[i] + s * a[i]).collect();
+        nonholonomic_b(&sys, &qs, &us, t + s, &ext).1
+    };
+    let (gp, gm) = (at(h), at(-h));
+    let (b, _) = nonholonomic_b(&sys, q, u, t, &ext);
+    let mut want = nonholonomic_gamma(&sys, q, u, t, &ext);
+    for (r, c, v) in b {
+        want[r] += v * a[c];
+    }
+    for r in 0..sys.mn {
+        let fd = (gp[r] - gm[r]) / (2.0 * h);
+        assert!((fd - want[r]).abs() < 1e-6 * want[r].abs().max(1.0), "row {r}: fd {fd} vs {}", want[r]);
     }
 }

@@ -67,6 +67,18 @@ pub fn run(args: &LinearizeArgs, out: &mut dyn Write) -> Result<(), CliError> {
         let rows = eigen_table(&lin.a).map_err(|e| CliError::Engine(e.into()))?;
         writeln!(out, "\nt = {t}: {} states, {} eigenvalues", lin.states.len(), lin.a.nrows()).map_err(io_err)?;
         write!(out, "{}", format_table(&rows)).map_err(io_err)?;
+        let (s0, s1) = (sel.states.len(), sel.velocities.len());
+        if s1 < s0 {
+            writeln!(
+                out,
+                "note: at least s0 - s1 = {} eigenvalues are zero because of the non-holonomic constraints: \
+                 {s0} position states but {s1} velocity states, so {} position combinations only integrate \
+                 the velocities and never feed back",
+                s0 - s1,
+                s0 - s1
+            )
+            .map_err(io_err)?;
+        }
         results.push(lin);
     }
     match args.format.as_str() {
@@ -91,6 +103,10 @@ pub fn run(args: &LinearizeArgs, out: &mut dyn Write) -> Result<(), CliError> {
 pub fn print_selection(sel: &Selection, out: &mut dyn Write) -> std::io::Result<()> {
     let names: Vec<&str> = sel.states.iter().map(|s| s.name.as_str()).collect();
     writeln!(out, "linearization states ({}): {}", names.len(), names.join(", "))?;
+    if sel.velocities.len() < sel.states.len() {
+        let w: Vec<String> = sel.velocities.iter().map(|w| w.name()).collect();
+        writeln!(out, "velocity states ({}, non-holonomic constraints): {}", w.len(), w.join(", "))?;
+    }
     if !sel.dropped.is_empty() {
         writeln!(out, "dropped user states (not independent of the others): {}", sel.dropped.join(", "))?;
     }

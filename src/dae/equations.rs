@@ -3,6 +3,7 @@
 //!   M u̇ = Q(u, q, Z, v, t) − Pᵀλ (Eq. 13a, P = C_q H)
 //!   Ẋ' = X-rate unknown, 0 = r(q, u, Z, v, t)  (user rows, Eq. 7a–7b; Z = (X, Ẋ, V))
 //!   0 = C(q, t)                   (Eq. 13e)
+//!   0 = g(q, u, t) = B u + b      (non-holonomic, multipliers ν; Bᵀν joins Pᵀλ)
 //!   0 = C_q H u + C_t             (Eq. 13d)
 //! with exact sparse Jacobians from the element kernels.
 
@@ -11,7 +12,7 @@ use crate::mechanics::System;
 use crate::mechanics::body::{NQ, h_transpose_times, qdot};
 use crate::mechanics::kernels::{
     constraint_first, constraint_second, dhtw_dq, dqdot_dq, force_ext_jacobian, force_jacobian, force_values, gather,
-    gyroscopic, user_jacobian, user_residual,
+    gyroscopic, nonholonomic_second, user_jacobian, user_residual,
 };
 
 /// Index layout of y.
@@ -23,20 +24,22 @@ pub struct Layout {
     pub nx: usize,
     /// User variables V.
     pub nv: usize,
+    /// Non-holonomic equations (multipliers ν).
+    pub mn: usize,
 }
 
 impl Layout {
     /// The layout of a system's equations.
     pub fn of(sys: &System) -> Layout {
-        Layout { n: sys.n(), m: sys.m, nx: sys.nx, nv: sys.nv }
+        Layout { n: sys.n(), m: sys.m, nx: sys.nx, nv: sys.nv, mn: sys.mn }
     }
     /// Number of user unknowns Z = (X, Ẋ, V).
     pub fn nz(&self) -> usize {
         2 * self.nx + self.nv
     }
-    /// Total dimension 2n + nz + 2m.
+    /// Total dimension 2n + nz + 2m + mn.
     pub fn dim(&self) -> usize {
-        2 * self.n + self.nz() + 2 * self.m
+        2 * self.n + self.nz() + 2 * self.m + self.mn
     }
     /// Offset of u.
     pub fn u(&self) -> usize {
@@ -50,9 +53,13 @@ impl Layout {
     pub fn lam(&self) -> usize {
         2 * self.n + self.nz()
     }
+    /// Offset of ν (after λ).
+    pub fn nu(&self) -> usize {
+        2 * self.n + self.nz() + self.m
+    }
     /// Offset of μ.
     pub fn mu(&self) -> usize {
-        2 * self.n + self.nz() + self.m
+        2 * self.n + self.nz() + self.m + self.mn
     }
     /// The external values [inputs; Z] of state `y`.
     pub fn ext(&self, inputs: &[f64], y: &[f64]) -> Vec<f64> {
@@ -114,6 +121,18 @@ pub fn rhs(sys: &System, lay: Layout, t: f64, y: &[f64], inputs: &[f64], f: &mut
         f[o..o + NQ].copy_from_slice(&qdot(&q[o..o + NQ], &u[o..o + NQ]));
     }
     applied_forces(sys, q, u, t, inputs, &mut f[nu..nu + n]);
+    let nn = lay.nu();
+    for el in &sys.nonholonomic {
+        let s = nonholonomic_second(sys, el, q, u, t, inputs);
+        let nql = NQ * el.bodies.len();
+        for e in 0..el.neq {
+            let nu_e = y[nn + el.row + e];
+            f[nn + el.row + e] = s.c[e]; // g = B u + b = 0
+            for a in 0..nql {
+                f[nu + glob(&el.bodies, a)] -= s.grad[e * s.k + nql + a] * nu_e; // −Bᵀν
+            }
+        }
+    }
     for el in &sys.constraints {
         let cf = constraint_first(sys, el, q, t, inputs);
         let nql = NQ * el.bodies.len();
@@ -188,6 +207,36 @@ pub fn jacobian(sys: &System, lay: Layout, t: f64, y: &[f64], inputs: &[f64], ja
         for r in 0..3 {
             for c in 0..3 {
                 jac.push(nu + o + 3 + r, nu + o + 3 + c, gj[r * 3 + c]);
+            }
+        }
+    }
+    let nn = lay.nu();
+    for el in &sys.nonholonomic {
+        let s = nonholonomic_second(sys, el, q, u, t, inputs);
+        let (nql, k) = (NQ * el.bodies.len(), s.k);
+        let mut bq = vec![0.0; 2 * nql * nql]; // Σ ν_e ∂B_e/∂(q, u), rows = u entries
+        for e in 0..el.neq {
+            let row = nn + el.row + e;
+            let g = &s.grad[e * k..(e + 1) * k];
+            let hs = &s.hess[e * k * k..(e + 1) * k * k];
+            let nu_e = y[row];
+            for a in 0..nql {
+                let ga = glob(&el.bodies, a);
+                jac.push(row, ga, g[a]);
+                jac.push(row, nu + ga, g[nql + a]);
+                jac.push(nu + ga, row, -g[nql + a]);
+                if nu_e != 0.0 {
+                    for c in 0..2 * nql {
+                        bq[a * 2 * nql + c] += nu_e * hs[(nql + a) * k + c];
+                    }
+                }
+            }
+        }
+        for a in 0..nql {
+            let ga = glob(&el.bodies, a);
+            for c in 0..2 * nql {
+                let gc = glob(&el.bodies, c % nql) + if c < nql { 0 } else { nu };
+                jac.push(nu + ga, gc, -bq[a * 2 * nql + c]);
             }
         }
     }
@@ -336,4 +385,42 @@ pub fn acceleration_rhs(sys: &System, q: &[f64], u: &[f64], t: f64, inputs: &[f6
         }
     }
     gamma
+}
+
+/// γ of the non-holonomic acceleration constraint B u̇ + γ = 0: ġ at u̇ = 0, i.e.
+/// g_q q̇ + g_t.
+pub fn nonholonomic_gamma(sys: &System, q: &[f64], u: &[f64], t: f64, ext: &[f64]) -> Vec<f64> {
+    let mut gamma = vec![0.0; sys.mn];
+    for el in &sys.nonholonomic {
+        let s = nonholonomic_second(sys, el, q, u, t, ext);
+        let nql = NQ * el.bodies.len();
+        let (ql, ul) = (gather(&el.bodies, q), gather(&el.bodies, u));
+        let mut qd = vec![0.0; nql];
+        for kb in 0..el.bodies.len() {
+            let r = NQ * kb..NQ * kb + NQ;
+            qd[r.clone()].copy_from_slice(&qdot(&ql[r.clone()], &ul[r]));
+        }
+        for e in 0..el.neq {
+            let g = &s.grad[e * s.k..(e + 1) * s.k];
+            gamma[el.row + e] = (0..nql).map(|a| g[a] * qd[a]).sum::<f64>() + g[2 * nql];
+        }
+    }
+    gamma
+}
+
+/// B = ∂g/∂u of the non-holonomic constraints as (row, global column, value), with g.
+pub fn nonholonomic_b(sys: &System, q: &[f64], u: &[f64], t: f64, ext: &[f64]) -> (Vec<(usize, usize, f64)>, Vec<f64>) {
+    let mut b = Vec::new();
+    let mut g = vec![0.0; sys.mn];
+    for el in &sys.nonholonomic {
+        let s = nonholonomic_second(sys, el, q, u, t, ext);
+        let nql = NQ * el.bodies.len();
+        for e in 0..el.neq {
+            g[el.row + e] = s.c[e];
+            for a in 0..nql {
+                b.push((el.row + e, glob(&el.bodies, a), s.grad[e * s.k + nql + a]));
+            }
+        }
+    }
+    (b, g)
 }

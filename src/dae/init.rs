@@ -3,7 +3,7 @@
 //! consistent velocities (closest to the given ones), then accelerations and Lagrange
 //! multipliers from [M Pᵀ; P 0][u̇; λ] = [Q; −γ] (Eq. 1c–1d).
 
-use super::equations::{acceleration_rhs, applied_forces, p_row};
+use super::equations::{acceleration_rhs, applied_forces, nonholonomic_b, nonholonomic_gamma, p_row};
 use super::sparse::{SparseLu, Triplets};
 use crate::mechanics::System;
 use crate::mechanics::body::NQ;
@@ -185,14 +185,26 @@ pub fn assemble_velocities(sys: &System, q: &[f64], u: &mut [f64], t: f64, input
     let n = sys.n();
     let m = sys.m;
     let nic = sys.ic_velocities.len();
+    let mn = sys.mn;
     let mut kkt = Triplets::new();
     for i in 0..n {
         kkt.push(i, i, 1.0);
     }
-    let mut rhs = vec![0.0; n + m + nic];
+    let mut rhs = vec![0.0; n + m + nic + mn];
     rhs[..n].copy_from_slice(u);
     for (row, ct) in push_p_blocks(sys, q, t, inputs, n, &mut kkt) {
         rhs[row] = -ct;
+    }
+    // Non-holonomic rows (after the ICs): B u = B u_given − g(u_given) = −b.
+    let (b, g) = nonholonomic_b(sys, q, u, t, inputs);
+    let r0 = n + m + nic;
+    for (r, gv) in g.iter().enumerate() {
+        rhs[r0 + r] = -gv;
+    }
+    for (r, c, v) in b {
+        kkt.push(r0 + r, c, v);
+        kkt.push(c, r0 + r, v);
+        rhs[r0 + r] += v * u[c];
     }
     for (k, ic) in sys.ic_velocities.iter().enumerate() {
         // Linear in u: residual(u) = a·u − value; a from dual numbers seeded on u.
@@ -212,7 +224,7 @@ pub fn assemble_velocities(sys: &System, q: &[f64], u: &mut [f64], t: f64, input
         rhs[r] = au - res.val();
     }
     let mut lu = SparseLu::new();
-    lu.factor(n + m + nic, &kkt).map_err(|e| format!("cannot make velocities consistent: {e}"))?;
+    lu.factor(n + m + nic + mn, &kkt).map_err(|e| format!("cannot make velocities consistent: {e}"))?;
     if !lu.solve(&mut rhs) {
         return Err("cannot make velocities consistent: singular velocity constraints".into());
     }
@@ -220,7 +232,7 @@ pub fn assemble_velocities(sys: &System, q: &[f64], u: &mut [f64], t: f64, input
     Ok(())
 }
 
-/// Accelerations u̇ and multipliers λ: [M Pᵀ; P 0][u̇; λ] = [Q; −γ].
+/// Accelerations u̇ and multipliers (λ; ν): [M Pᵀ Bᵀ; P 0 0; B 0 0][u̇; λ; ν] = [Q; −γ; −γ_nh].
 pub fn accelerations(
     sys: &System,
     q: &[f64],
@@ -243,13 +255,23 @@ pub fn accelerations(
             }
         }
     }
-    let mut rhs = vec![0.0; n + m];
+    let mn = sys.mn;
+    let mut rhs = vec![0.0; n + m + mn];
     applied_forces(sys, q, u, t, inputs, &mut rhs[..n]);
     let gamma = acceleration_rhs(sys, q, u, t, inputs);
     for (row, _) in push_p_blocks(sys, q, t, inputs, n, &mut kkt) {
         rhs[row] = -gamma[row - n];
     }
-    lu.factor(n + m, &kkt).map_err(|e| format!("cannot solve accelerations: {e}"))?;
+    // Non-holonomic rows: B u̇ = −γ_nh; Bᵀν in the equations of motion.
+    let (b, _) = nonholonomic_b(sys, q, u, t, inputs);
+    for (r, c, v) in b {
+        kkt.push(n + m + r, c, v);
+        kkt.push(c, n + m + r, v);
+    }
+    for (r, gm) in nonholonomic_gamma(sys, q, u, t, inputs).into_iter().enumerate() {
+        rhs[n + m + r] = -gm;
+    }
+    lu.factor(n + m + mn, &kkt).map_err(|e| format!("cannot solve accelerations: {e}"))?;
     if !lu.solve(&mut rhs) {
         return Err("cannot solve accelerations: singular (redundant constraints?)".into());
     }
@@ -281,7 +303,7 @@ pub fn static_equilibrium(
     // the reactions' geometric term (Pᵀλ)_q, absent at λ = 0.
     let ext = lay.ext(inputs, &y);
     let (_, lam0) = accelerations(sys, q, &vec![0.0; n], t, &ext, &mut lu)?;
-    y[nl..nl + m].copy_from_slice(&lam0);
+    y[nl..nl + m].copy_from_slice(&lam0[..m]);
     // Equations: u rows, user rows, C rows; unknowns: q, X, V, λ (Ẋ = 0 held).
     let rows: Vec<usize> = (n..2 * n).chain(nz + nx..nz + lay.nz()).chain(nl..nl + m).collect();
     let cols: Vec<usize> = (0..n).chain(nz..nz + nx).chain(nz + 2 * nx..nz + lay.nz()).chain(nl..nl + m).collect();

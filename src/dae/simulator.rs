@@ -285,7 +285,7 @@ impl Simulator {
         y[..lay.n].copy_from_slice(&q);
         y[lay.u()..lay.u() + lay.n].copy_from_slice(&u);
         y[lay.z()..lay.z() + lay.nz()].copy_from_slice(&z);
-        y[lay.lam()..lay.lam() + lay.m].copy_from_slice(&lam);
+        y[lay.lam()..lay.lam() + lay.m + lay.mn].copy_from_slice(&lam); // λ then ν
         let slopes = vec![0.0; inputs.len()];
         let mut dae = MultibodyDae { sys, lay, inputs, slopes, t_in: t0 };
         dae.accepted(t0, &mut y);
@@ -401,7 +401,7 @@ impl Simulator {
             ConstraintKind::Joint { i, j, .. }
             | ConstraintKind::Rotation { i, j, .. }
             | ConstraintKind::Translation { i, j, .. } => (*i, Some(*j)),
-            ConstraintKind::User { .. } => return None,
+            ConstraintKind::User { .. } | ConstraintKind::WheelContact { .. } => return None,
         };
         let ql = gather(&el.bodies, q);
         let pi = ctx_pose(&LocalCtx::new(sys, &el.bodies, &ql, &[], &[], t, &inputs), mi);
@@ -422,6 +422,14 @@ impl Simulator {
             }
             _ => None,
         }
+    }
+
+    /// Largest |g_i(q, u, t)| over the non-holonomic constraints at the current time.
+    pub fn nonholonomic_residual(&self) -> f64 {
+        let s = &self.dae.sys;
+        let ext = self.ext();
+        let (_, g) = equations::nonholonomic_b(s, self.q(), self.u(), self.radau.t, &ext);
+        g.iter().fold(0.0, |a: f64, v| a.max(v.abs()))
     }
 
     /// Largest |C_i(q, t)| over the holonomic constraints at the current time.

@@ -30,13 +30,17 @@ pub struct Linearization {
     pub x: Vec<f64>,
 }
 
-/// Column (unknown) and row (equation) offsets of Eq. 34.
+/// Column (unknown) and row (equation) offsets of Eq. 34, generalized to s0 position
+/// states S, s1 ≤ s0 velocity states W, mn non-holonomic equations (multipliers ν) and
+/// the user unknowns Z. Unknowns: (u̇, q̇, Ẇ, Ṡ, λ, ν, u, q, W, S, Z).
 struct Blocks {
     n: usize,
     m: usize,
     /// Independent constraint rows (m minus the redundant ones): 34d–e have this many.
     mr: usize,
-    s: usize,
+    mn: usize,
+    s0: usize,
+    s1: usize,
     /// Differential states X and user unknowns Z = (X, Ẋ, V).
     nx: usize,
     nz: usize,
@@ -53,48 +57,53 @@ impl Blocks {
         2 * self.n
     }
     fn sd(&self) -> usize {
-        2 * self.n + self.s
+        self.wd() + self.s1
     }
     fn lam(&self) -> usize {
-        2 * self.n + 2 * self.s
+        self.sd() + self.s0
+    }
+    fn nu(&self) -> usize {
+        self.lam() + self.m
     }
     fn u(&self) -> usize {
-        2 * self.n + 2 * self.s + self.m
+        self.nu() + self.mn
     }
     fn q(&self) -> usize {
-        3 * self.n + 2 * self.s + self.m
+        self.u() + self.n
     }
     fn w(&self) -> usize {
-        4 * self.n + 2 * self.s + self.m
+        self.q() + self.n
     }
     fn sv(&self) -> usize {
-        4 * self.n + 3 * self.s + self.m
+        self.w() + self.s1
     }
     fn z(&self) -> usize {
-        4 * self.n + 4 * self.s + self.m
+        self.sv() + self.s0
     }
     fn dim(&self) -> usize {
-        4 * self.n + 4 * self.s + self.m + self.nz
+        self.z() + self.nz
     }
-    // Rows: 34a n, 34b n, 34c m (redundant rows: λ = 0), 34d mr, 34e mr, 34f..34k s each,
-    // then the user rows r = 0 (nz − nx, Eq. 7a–7b) and X = X̄ (nx).
+    // Rows: 34a n, 34b n, 34c m + mn (redundant rows: λ = 0; then ġ = 0), 34d mr + mn
+    // (Ċ = 0, g = 0), 34e mr, 34f s0 (S = s), 34g s0 (Ṡ = ṡ), 34h s1 (W = w), 34i s1
+    // (Ẇ = ẇ), 34j s1 (W = W̄), 34k s0 (S = S̄), then the user rows r = 0 (nz − nx,
+    // Eq. 7a–7b) and X = X̄ (nx).
     fn row(&self, eq: char) -> usize {
-        let (n, m, mr, s) = (self.n, self.m, self.mr, self.s);
-        let f = 2 * n + m + 2 * mr;
+        let (n, m, mr, mn, s0, s1) = (self.n, self.m, self.mr, self.mn, self.s0, self.s1);
+        let f = 2 * n + m + mn + 2 * mr + mn;
         match eq {
             'a' => 0,
             'b' => n,
             'c' => 2 * n,
-            'd' => 2 * n + m,
-            'e' => 2 * n + m + mr,
+            'd' => 2 * n + m + mn,
+            'e' => 2 * n + m + mn + mr + mn,
             'f' => f,
-            'g' => f + s,
-            'h' => f + 2 * s,
-            'i' => f + 3 * s,
-            'j' => f + 4 * s,
-            'k' => f + 5 * s,
-            'l' => f + 6 * s,
-            _ => f + 6 * s + self.nz - self.nx,
+            'g' => f + s0,
+            'h' => f + 2 * s0,
+            'i' => f + 2 * s0 + s1,
+            'j' => f + 2 * s0 + 2 * s1,
+            'k' => f + 2 * s0 + 3 * s1,
+            'l' => f + 3 * s0 + 3 * s1,
+            _ => f + 3 * s0 + 3 * s1 + self.nz - self.nx,
         }
     }
 }
@@ -165,7 +174,7 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
     let inputs = &ext[..];
     let (q, u) = (sim.q().to_vec(), sim.u().to_vec());
     let sys = sim.system();
-    let (n, m, s) = (sys.n(), sys.m, sel.states.len());
+    let (n, m, mn, s0, s1) = (sys.n(), sys.m, sys.mn, sel.states.len(), sel.velocities.len());
     // Compact index of each independent constraint row (rows of 34d–e).
     let mut cmap = vec![None; m];
     let mut mr = 0;
@@ -175,26 +184,27 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
             mr += 1;
         }
     }
-    if s + mr != n {
+    if s0 + mr != n || s1 + mn != s0 {
         return Err(EngineError::Numeric(format!(
-            "{s} linearization states do not complete {mr} independent constraints to {n} coordinates"
+            "{s0} position and {s1} velocity states do not complete {mr} independent constraints and {mn} \
+             non-holonomic ones to {n} coordinates"
         )));
     }
     check_partition(sys, sel, &q, t, inputs)?;
     let lay = Layout::of(sys);
     let (nx, nz, ni) = (lay.nx, lay.nz(), sys.ni());
-    let bl = Blocks { n, m, mr, s, nx, nz };
+    let bl = Blocks { n, m, mr, mn, s0, s1, nx, nz };
     let mut k = Triplets::new();
-    // Eq. 34a, 34b, 34d, 34e from the integrator's exact Jacobian of
-    // f = [Hu; Q − Pᵀλ; C; Ċ] at μ = 0.
+    // Eq. 34a, 34b, 34d, 34e and the user rows from the integrator's exact Jacobian of
+    // f = [Hu; Q − Pᵀλ − Bᵀν; X' = Ẋ, r; C; g; Ċ] at μ = 0.
     let mut y = vec![0.0; lay.dim()];
     y[..n].copy_from_slice(&q);
     y[n..2 * n].copy_from_slice(&u);
     y[lay.z()..lay.z() + nz].copy_from_slice(&ext[ni..]);
-    y[lay.lam()..lay.lam() + m].copy_from_slice(&lam);
+    y[lay.lam()..lay.lam() + m + mn].copy_from_slice(&lam);
     let mut jac = Triplets::new();
     jacobian(sys, lay, t, &y, &inputs[..ni], &mut jac);
-    let (lz, ll, lm) = (lay.z(), lay.lam(), lay.mu());
+    let (lz, ll, ln, lm) = (lay.z(), lay.lam(), lay.nu(), lay.mu());
     for (p, &v) in jac.idx.iter().zip(&jac.vals) {
         let (r, c) = (p.row, p.col);
         let col = if c < n {
@@ -204,22 +214,24 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
         } else if c < ll {
             bl.z() + c - lz
         } else if c < lm {
-            bl.lam() + c - ll
+            bl.lam() + c - ll // λ then ν, contiguous in both
         } else {
             continue; // μ does not appear in Eq. 34
         };
         if r < n {
             k.push(bl.row('b') + r, col, -v); // 34b: q̇ − H(q)u
         } else if r < 2 * n {
-            k.push(bl.row('a') + r - n, col, -v); // 34a: M u̇ − (Q − Pᵀλ)
+            k.push(bl.row('a') + r - n, col, -v); // 34a: M u̇ − (Q − Pᵀλ − Bᵀν)
         } else if r < lz + nx {
             continue; // X' = Ẋ: the rate of X is the unknown Ẋ itself
         } else if r < ll {
             k.push(bl.row('l') + r - lz - nx, col, v); // Eq. 7a–7b: r(q, u, Z, v, t) = 0
-        } else if r < lm {
+        } else if r < ln {
             if let Some(cr) = cmap[r - ll] {
                 k.push(bl.row('e') + cr, col, v); // 34e: C
             }
+        } else if r < lm {
+            k.push(bl.row('d') + mr + r - ln, col, v); // 34d: g = B u + b (non-holonomic)
         } else if let Some(cr) = cmap[r - lm] {
             k.push(bl.row('d') + cr, col, v); // 34d: Ċ
         }
@@ -241,7 +253,7 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
             }
         }
     }
-    // Eq. 34c: C̈(u̇, u, q, t) = 0, exact gradients from the time jets.
+    // Rows of gradients over the local (q, u, u̇) of `bodies`.
     let push_z = |k: &mut Triplets, row: usize, bodies: &[usize], dz: &[f64], sign: f64, with_acc: bool| {
         let nql = NQ * bodies.len();
         for a in 0..nql {
@@ -253,6 +265,7 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
             }
         }
     };
+    // Eq. 34c: C̈(u̇, u, q, t) = 0 and ġ(u̇, u, q, t) = 0, exact gradients from the time jets.
     for el in &sys.constraints {
         for (e, jet) in jets(sys, el, &q, &u, &udot, t, inputs).iter().enumerate() {
             if sys.redundant[el.row + e] {
@@ -262,34 +275,44 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
             }
         }
     }
-    // Eq. 34f–34k for each selected state.
-    let ns = 2 * s + nx;
+    for el in &sys.nonholonomic {
+        for (e, jet) in jets(sys, el, &q, &u, &udot, t, inputs).iter().enumerate() {
+            push_z(&mut k, bl.row('c') + m + el.row + e, &el.bodies, &jet.dg1, 1.0, true);
+        }
+    }
+    // Eq. 34f, 34g, 34k for each position state; 34h, 34i, 34j for each velocity state.
+    let ns = s0 + s1 + nx;
     let mut x = vec![0.0; ns];
-    x[2 * s..].copy_from_slice(&ext[ni..ni + nx]);
+    x[s0 + s1..].copy_from_slice(&ext[ni..ni + nx]);
     for (i, st) in sel.states.iter().enumerate() {
         let jet = &jets(sys, st, &q, &u, &udot, t, inputs)[0];
         x[i] = jet.g;
-        x[s + i] = jet.g1;
         k.push(bl.row('f') + i, bl.sv() + i, 1.0);
         push_z(&mut k, bl.row('f') + i, st.bodies(), &jet.dg, -1.0, false);
         k.push(bl.row('g') + i, bl.sd() + i, 1.0);
-        k.push(bl.row('g') + i, bl.w() + i, -1.0);
-        k.push(bl.row('h') + i, bl.w() + i, 1.0);
-        push_z(&mut k, bl.row('h') + i, st.bodies(), &jet.dg1, -1.0, false);
-        k.push(bl.row('i') + i, bl.wd() + i, 1.0);
-        push_z(&mut k, bl.row('i') + i, st.bodies(), &jet.dg2, -1.0, true);
-        k.push(bl.row('j') + i, bl.w() + i, 1.0);
+        push_z(&mut k, bl.row('g') + i, st.bodies(), &jet.dg1, -1.0, false);
         k.push(bl.row('k') + i, bl.sv() + i, 1.0);
+    }
+    for (i, ws) in sel.velocities.iter().enumerate() {
+        let jet = ws.jet(sys, &q, &u, &udot, t, inputs);
+        x[s0 + i] = jet.w;
+        k.push(bl.row('h') + i, bl.w() + i, 1.0);
+        push_z(&mut k, bl.row('h') + i, ws.bodies(), &jet.dw, -1.0, false);
+        k.push(bl.row('i') + i, bl.wd() + i, 1.0);
+        push_z(&mut k, bl.row('i') + i, ws.bodies(), &jet.dwd, -1.0, true);
+        k.push(bl.row('j') + i, bl.w() + i, 1.0);
     }
     // Right-hand sides: ∂/∂S̄ (34k), ∂/∂W̄ (34j), ∂/∂X̄, ∂/∂v (34a: +∂Q/∂v; user rows: −∂r/∂v).
     let dim = bl.dim();
     let mut rhs = Mat::<f64>::zeros(dim, ns + ni);
-    for i in 0..s {
+    for i in 0..s0 {
         rhs[(bl.row('k') + i, i)] = 1.0;
-        rhs[(bl.row('j') + i, s + i)] = 1.0;
+    }
+    for i in 0..s1 {
+        rhs[(bl.row('j') + i, s0 + i)] = 1.0;
     }
     for i in 0..nx {
-        rhs[(bl.row('x') + i, 2 * s + i)] = 1.0;
+        rhs[(bl.row('x') + i, s0 + s1 + i)] = 1.0;
     }
     for el in &sys.forces {
         for (v, col) in force_ext_jacobian(sys, el, &q, &u, t, inputs) {
@@ -312,7 +335,12 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
         EngineError::Numeric(format!(
             "at t = {t}: the linearization states ({}) no longer parameterize the motion (singular partition); \
              choose user states (<linearization>) that stay independent",
-            sel.states.iter().map(|s| s.name.as_str()).collect::<Vec<_>>().join(", ")
+            sel.states
+                .iter()
+                .map(|s| s.name.clone())
+                .chain(sel.velocities.iter().map(|w| w.name()))
+                .collect::<Vec<_>>()
+                .join(", ")
         ))
     };
     lu.factor(dim, &k).map_err(|_| singular())?;
@@ -321,17 +349,17 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
     }
     // A and B: rows Ṡ, Ẇ, Ẋ of the solution.
     let pick = |r: usize, c: usize| {
-        if r < s {
+        if r < s0 {
             rhs[(bl.sd() + r, c)]
-        } else if r < 2 * s {
-            rhs[(bl.wd() + r - s, c)]
+        } else if r < s0 + s1 {
+            rhs[(bl.wd() + r - s0, c)]
         } else {
-            rhs[(bl.z() + nx + r - 2 * s, c)]
+            rhs[(bl.z() + nx + r - s0 - s1, c)]
         }
     };
     let a = Mat::from_fn(ns, ns, pick);
     let b = Mat::from_fn(ns, ni, |r, c| pick(r, ns + c));
-    // C and D: chain rule through q, u, u̇ sensitivities.
+    // C and D: chain rule through q, u, u̇ and Z sensitivities.
     let no = sys.outputs.len();
     let mut c = Mat::<f64>::zeros(no, ns);
     let mut d = Mat::<f64>::zeros(no, ni);
@@ -367,7 +395,7 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
         }
     }
     let mut states: Vec<String> = sel.states.iter().map(|s| s.name.clone()).collect();
-    states.extend(sel.states.iter().map(|s| format!("der({})", s.name)));
+    states.extend(sel.velocities.iter().map(|w| w.name()));
     states.extend(sys.user.iter().take(nx).map(|u| u.name.clone()));
     Ok(Linearization {
         time: t,

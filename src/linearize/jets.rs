@@ -22,6 +22,26 @@ pub trait PositionFn {
     fn components(&self) -> usize;
     /// Evaluate into `out`.
     fn eval<T: Real>(&self, ctx: &LocalCtx<T>, out: &mut [T]);
+    /// Whether it reads velocities (a velocity-level function w(q, u, t): its jet gives w
+    /// and ẇ exactly; the second derivative is not available and reads as if ü = 0).
+    fn reads_velocities(&self) -> bool {
+        false
+    }
+}
+
+impl PositionFn for crate::mechanics::nonholonomic::NonholonomicEl {
+    fn bodies(&self) -> &[usize] {
+        &self.bodies
+    }
+    fn components(&self) -> usize {
+        self.neq
+    }
+    fn eval<T: Real>(&self, ctx: &LocalCtx<T>, out: &mut [T]) {
+        self.kind.eval(ctx, out)
+    }
+    fn reads_velocities(&self) -> bool {
+        true
+    }
 }
 
 impl PositionFn for ConstraintEl {
@@ -86,6 +106,8 @@ fn jets_k<const K: usize, F: PositionFn>(
     let ab = seed(gather(bodies, udot), 2 * nq);
     let tb = B::<K>::var(t, 3 * nq);
     let mut qj = Vec::with_capacity(nq);
+    let uj: Vec<_> =
+        if f.reads_velocities() { ub.iter().zip(&ab).map(|(&v, &d)| jet(v, d, B::zero())).collect() } else { vec![] };
     for k in 0..bodies.len() {
         let r = NQ * k..NQ * k + NQ;
         let qd = qdot(&qb[r.clone()], &ub[r.clone()]);
@@ -98,7 +120,7 @@ fn jets_k<const K: usize, F: PositionFn>(
         }
     }
     let tj = jet(tb, B::one(), B::zero());
-    let ctx = LocalCtx::new(sys, bodies, &qj, &[], &[], tj, inputs);
+    let ctx = LocalCtx::new(sys, bodies, &qj, &uj, &[], tj, inputs);
     let mut out = vec![Dual::zero(); f.components()];
     f.eval(&ctx, &mut out);
     let kk = 3 * nq + 1;

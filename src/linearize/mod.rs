@@ -7,6 +7,7 @@ pub mod eigen;
 pub mod jets;
 pub mod outputs;
 pub mod select;
+pub mod select_velocity;
 pub mod states;
 
 pub use augmented::{Linearization, linearize};
@@ -47,7 +48,8 @@ pub fn selection_by_name(sys: &System, names: &[String]) -> Result<Selection, St
             }
         })
         .collect::<Result<Vec<_>, String>>()?;
-    Ok(Selection { states, dropped: vec![], rank: sys.redundant.iter().filter(|r| !**r).count() })
+    let velocities = select_velocity::derivative_states(&states);
+    Ok(Selection { states, velocities, dropped: vec![], rank: sys.redundant.iter().filter(|r| !**r).count() })
 }
 
 /// Values of the states S, their velocities W = Ṡ and accelerations Ẇ at the current point.

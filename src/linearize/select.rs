@@ -5,23 +5,28 @@
 //! the user gave too few; user states that found a pivot are dropped (too many).
 
 use super::jets::{PositionFn, jets};
-use super::states::{StateFn, internal_state, user_states};
+use super::select_velocity::{derivative_states, select_velocities};
+use super::states::{StateFn, VelState, internal_state, user_states};
 use crate::mechanics::System;
 use crate::mechanics::body::NQ;
 use crate::mechanics::kernels::constraint_first;
 use faer::Mat;
 
 /// Weight of user-state rows relative to constraint rows (Eq. 33's row weighting).
-const USER_ROW_WEIGHT: f64 = 1e3;
+pub const USER_ROW_WEIGHT: f64 = 1e3;
 /// The small diagonal D replacing the identity in Eq. 33 (biases column pivoting).
-const D_SMALL: f64 = 1e-3;
+pub const D_SMALL: f64 = 1e-3;
 /// A pivot below this fraction of the largest |J| entry counts as zero (rank decision).
 pub const RANK_TOL: f64 = 1e-9;
 
 /// The chosen states and what was dropped.
 #[derive(Clone, Debug)]
 pub struct Selection {
+    /// Position-level states S (s0 of them).
     pub states: Vec<StateFn>,
+    /// Velocity-level states W (s1 ≤ s0; the derivatives of S without non-holonomic
+    /// constraints).
+    pub velocities: Vec<VelState>,
     /// Names of user states dropped because they were not independent (too many).
     pub dropped: Vec<String>,
     /// Number of independent constraint equations (m minus redundant ones).
@@ -78,6 +83,15 @@ pub fn select_states(sys: &System, q: &[f64], t: f64, inputs: &[f64]) -> Result<
     let mut internal: Vec<usize> = free.iter().copied().filter(|&c| c < n).collect();
     internal.sort_unstable();
     states.extend(internal.iter().map(|&c| internal_state(sys, c)));
-    let dropped = (0..nu).filter(|k| pivoted.contains(&(n + k))).map(|k| users[k].name.clone()).collect();
-    Ok(Selection { states, dropped, rank: rank.saturating_sub(nu) })
+    let mut dropped: Vec<String> =
+        (0..nu).filter(|k| pivoted.contains(&(n + k))).map(|k| users[k].name.clone()).collect();
+    let velocities = if sys.mn == 0 {
+        derivative_states(&states)
+    } else {
+        // B and the candidates' u-gradients do not depend on u (linear in velocities).
+        let (v, d) = select_velocities(sys, q, &vec![0.0; n], t, inputs)?;
+        dropped.extend(d.into_iter().filter(|d| !states.iter().any(|s| format!("der({})", s.name) == *d)));
+        v
+    };
+    Ok(Selection { states, velocities, dropped, rank: rank.saturating_sub(nu) })
 }

@@ -2,12 +2,96 @@
 //! candidates — each body's CM coordinates and its 3-1-3 angles relative to a reference
 //! frame fixed at selection time (so the names mean the same at every later point).
 
-use super::jets::PositionFn;
+use super::jets::{PositionFn, jets};
 use crate::ad::Real;
 use crate::geom::{M3, euler313_from_matrix};
 use crate::mechanics::System;
 use crate::mechanics::local::LocalCtx;
 use crate::model::expr::{Expr, deps};
+
+/// A velocity-level state W (seed Eq. 34h): the time derivative of a position-level
+/// candidate, or a user `<velocity>` expression w(q, u, t).
+#[derive(Clone, Debug, PartialEq)]
+pub enum VelState {
+    Derivative(StateFn),
+    User(UserVelocity),
+}
+
+/// A `<linearization><velocity>` expression.
+#[derive(Clone, Debug, PartialEq)]
+pub struct UserVelocity {
+    pub name: String,
+    pub f: Expr,
+    pub abase: usize,
+    pub bodies: Vec<usize>,
+}
+
+impl PositionFn for UserVelocity {
+    fn bodies(&self) -> &[usize] {
+        &self.bodies
+    }
+    fn components(&self) -> usize {
+        1
+    }
+    fn eval<T: Real>(&self, ctx: &LocalCtx<T>, out: &mut [T]) {
+        out[0] = ctx.eval_expr(&self.f, self.abase);
+    }
+    fn reads_velocities(&self) -> bool {
+        true
+    }
+}
+
+/// w, ẇ of a velocity state with gradients over (local q, local u, local u̇, t).
+pub struct VelJet {
+    pub w: f64,
+    pub wd: f64,
+    pub dw: Vec<f64>,
+    pub dwd: Vec<f64>,
+}
+
+impl VelState {
+    /// Its name: `der(S)` for a derivative, else the user's name.
+    pub fn name(&self) -> String {
+        match self {
+            VelState::Derivative(s) => format!("der({})", s.name),
+            VelState::User(u) => u.name.clone(),
+        }
+    }
+    /// Bodies it reads.
+    pub fn bodies(&self) -> &[usize] {
+        match self {
+            VelState::Derivative(s) => &s.bodies,
+            VelState::User(u) => &u.bodies,
+        }
+    }
+    /// Value, rate and their exact gradients at (q, u, u̇, t).
+    #[allow(clippy::too_many_arguments)]
+    pub fn jet(&self, sys: &System, q: &[f64], u: &[f64], udot: &[f64], t: f64, ext: &[f64]) -> VelJet {
+        match self {
+            VelState::Derivative(s) => {
+                let j = jets(sys, s, q, u, udot, t, ext).swap_remove(0);
+                VelJet { w: j.g1, wd: j.g2, dw: j.dg1, dwd: j.dg2 }
+            }
+            VelState::User(v) => {
+                let j = jets(sys, v, q, u, udot, t, ext).swap_remove(0);
+                VelJet { w: j.g, wd: j.g1, dw: j.dg, dwd: j.dg1 }
+            }
+        }
+    }
+}
+
+/// The user's `<velocity>` candidates of the model.
+pub fn user_velocities(sys: &System) -> Vec<UserVelocity> {
+    sys.lin_velocities
+        .iter()
+        .map(|(name, f, abase)| {
+            let mut bodies: Vec<usize> = deps(f).markers.iter().filter_map(|&m| sys.markers[m].body).collect();
+            bodies.sort_unstable();
+            bodies.dedup();
+            UserVelocity { name: name.clone(), f: f.clone(), abase: *abase, bodies }
+        })
+        .collect()
+}
 
 /// What a state measures.
 #[derive(Clone, Debug, PartialEq)]

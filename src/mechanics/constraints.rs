@@ -17,6 +17,8 @@ pub enum ConstraintKind {
     Translation { i: MarkerId, j: MarkerId, f: Expr, abase: usize },
     /// User constraint f(q, t) = 0.
     User { f: Expr, abase: usize },
+    /// A rolling wheel's contact point stays on its plane: (P − o)·n = 0.
+    WheelContact { m: MarkerId, radius: f64, plane: Option<MarkerId> },
 }
 
 /// One constraint element: its equations occupy rows `row..row+neq` of C.
@@ -66,6 +68,10 @@ impl ConstraintKind {
                 out[0] = (pi.p - pj.p).dot(&pj.r.col(2)) - fv;
             }
             ConstraintKind::User { f, abase } => out[0] = ctx.eval_expr(f, *abase),
+            ConstraintKind::WheelContact { m, radius, plane } => {
+                let (pc, n, o, _) = super::nonholonomic::wheel_contact(ctx, *m, *radius, *plane);
+                out[0] = (pc - o).dot(&n);
+            }
         }
     }
 }

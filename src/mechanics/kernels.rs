@@ -6,6 +6,7 @@ use super::body::{NQ, h_transpose_times, qdot};
 use super::constraints::ConstraintEl;
 use super::forces::ForceEl;
 use super::local::LocalCtx;
+use super::nonholonomic::NonholonomicEl;
 use super::system::System;
 use super::user::UserEq;
 use crate::ad::{Dual, Real};
@@ -99,6 +100,81 @@ fn second_k<const K: usize>(sys: &System, el: &ConstraintEl, q: &[f64], t: f64, 
         for a in 0..k {
             r.hess.extend(e.d[a].d[..k].iter().copied());
         }
+    }
+    r
+}
+
+/// g of a non-holonomic element with its gradient over z = (local q, local u, t) and the
+/// mixed second derivatives ∂²g/∂u∂(q, t) (what (Bᵀν)_q needs), in the layout of
+/// [`ConstraintSecond`] with K = 12nb + 1; the (q, q) and (u, u) blocks are left zero
+/// (g is linear in u). Nested duals: outer over u (6nb), inner over (q, t).
+pub fn nonholonomic_second(
+    sys: &System,
+    el: &NonholonomicEl,
+    q: &[f64],
+    u: &[f64],
+    t: f64,
+    ext: &[f64],
+) -> ConstraintSecond {
+    match el.bodies.len() {
+        0 => nh_second_k::<1, 1>(sys, el, q, u, t, ext),
+        1 => nh_second_k::<7, 6>(sys, el, q, u, t, ext),
+        2 => nh_second_k::<13, 12>(sys, el, q, u, t, ext),
+        3 => nh_second_k::<19, 18>(sys, el, q, u, t, ext),
+        _ => nh_second_k::<25, 24>(sys, el, q, u, t, ext),
+    }
+}
+
+/// A nested dual constant in the outer variables.
+fn outer_cst<const KQ: usize, const KU: usize>(v: Dual<f64, KQ>) -> Dual<Dual<f64, KQ>, KU> {
+    Dual { v, d: [Dual::zero(); KU] }
+}
+
+fn nh_second_k<const KQ: usize, const KU: usize>(
+    sys: &System,
+    el: &NonholonomicEl,
+    q: &[f64],
+    u: &[f64],
+    t: f64,
+    ext: &[f64],
+) -> ConstraintSecond {
+    let nq = NQ * el.bodies.len();
+    let k = 2 * nq + 1;
+    type D2<const KQ: usize, const KU: usize> = Dual<Dual<f64, KQ>, KU>;
+    let ql: Vec<D2<KQ, KU>> =
+        gather(&el.bodies, q).iter().enumerate().map(|(i, &v)| outer_cst(Dual::var(v, i))).collect();
+    let ul: Vec<D2<KQ, KU>> = gather(&el.bodies, u)
+        .iter()
+        .enumerate()
+        .map(|(i, &v)| Dual {
+            v: Dual::cst(v),
+            d: std::array::from_fn(|j| if j == i { Dual::one() } else { Dual::zero() }),
+        })
+        .collect();
+    let tt: D2<KQ, KU> = outer_cst(Dual::var(t, nq));
+    let ctx = LocalCtx::new(sys, &el.bodies, &ql, &ul, &[], tt, ext);
+    let mut out = vec![Dual::zero(); el.neq];
+    el.kind.eval(&ctx, &mut out);
+    let mut r = ConstraintSecond { k, c: vec![], grad: vec![], hess: vec![] };
+    for e in &out {
+        r.c.push(e.v.v);
+        let mut g = vec![0.0; k];
+        g[..nq].copy_from_slice(&e.v.d[..nq]);
+        for a in 0..nq {
+            g[nq + a] = e.d[a].v;
+        }
+        g[2 * nq] = e.v.d[nq];
+        r.grad.extend(g);
+        let mut h = vec![0.0; k * k];
+        for a in 0..nq {
+            for c in 0..nq {
+                h[(nq + a) * k + c] = e.d[a].d[c];
+                h[c * k + nq + a] = e.d[a].d[c];
+            }
+            h[(nq + a) * k + 2 * nq] = e.d[a].d[nq];
+            h[2 * nq * k + nq + a] = e.d[a].d[nq];
+        }
+        r.hess.extend(h);
     }
     r
 }

@@ -8,6 +8,7 @@ pub mod constraints;
 pub mod forces;
 pub mod kernels;
 pub mod local;
+pub mod nonholonomic;
 pub mod system;
 pub mod user;
 

@@ -9,6 +9,7 @@ use super::body::NQ;
 use super::constraints::{ConstraintEl, ConstraintKind, VelocityIc};
 use super::forces::{ForceEl, ForceKind};
 use super::kernels::MAX_ELEMENT_BODIES;
+use super::nonholonomic::{NonholonomicEl, NonholonomicKind};
 use super::user::{UserEq, UserKind, ext_refs};
 use crate::geom::{M3, rot_x};
 use crate::model::expr::{ElementRef, Expr, angle_count, deps};
@@ -53,6 +54,10 @@ pub struct System {
     /// Exact velocity initial conditions.
     pub ic_velocities: Vec<VelocityIc>,
     pub forces: Vec<ForceEl>,
+    /// Non-holonomic constraints g = B u + b = 0, rows laid out consecutively.
+    pub nonholonomic: Vec<NonholonomicEl>,
+    /// Number of non-holonomic equations.
+    pub mn: usize,
     /// User rows (differentials, then variables; seed Eq. 7a–7b).
     pub user: Vec<UserEq>,
     /// Number of differential states X and of variables V.
@@ -74,6 +79,8 @@ pub struct System {
     pub output_bases: Vec<usize>,
     /// User linearization states `<linearization><state>`: name, s(q, t), angle slot base.
     pub lin_states: Vec<(String, Expr, usize)>,
+    /// User velocity candidates `<linearization><velocity>`: name, w(q, u, t), slot base.
+    pub lin_velocities: Vec<(String, Expr, usize)>,
     /// Value of every angle measure at the last accepted step (NaN: none yet); expressions
     /// keep their angles on the branch nearest these, so angles are continuous in time.
     pub angle_refs: Vec<f64>,
@@ -220,6 +227,46 @@ impl System {
                 uc.pos,
             ));
         }
+        let mut nonholonomic = Vec::new();
+        for w in &model.rolling_wheels {
+            let (m, radius, plane) = (w.marker, w.radius.value, w.plane);
+            let mut ms = vec![m];
+            ms.extend(plane);
+            let bl = bodies_of(&ms, &[]);
+            let kind = ConstraintKind::WheelContact { m, radius, plane };
+            constraints.push(ConstraintEl::new(w.name.clone(), kind, bl.clone(), "rolling_wheel", w.pos));
+            let kind = NonholonomicKind::Rolling { m, radius, plane };
+            nonholonomic.push(NonholonomicEl::new(w.name.clone(), kind, bl, "rolling_wheel", w.pos));
+        }
+        for k in &model.knife_edges {
+            let kind = NonholonomicKind::KnifeEdge { m: k.marker };
+            nonholonomic.push(NonholonomicEl::new(
+                k.name.clone(),
+                kind,
+                bodies_of(&[k.marker], &[]),
+                "knife_edge",
+                k.pos,
+            ));
+        }
+        for v in &model.velocity_constraints {
+            let kind = NonholonomicKind::User { f: v.function.clone(), abase: alloc(&v.function) };
+            let bl = bodies_of(&[], &[&v.function]);
+            nonholonomic.push(NonholonomicEl::new(v.name.clone(), kind, bl, "velocity_constraint", v.pos));
+        }
+        let mut mn = 0;
+        for el in nonholonomic.iter_mut() {
+            el.row = mn;
+            mn += el.neq;
+        }
+        for c in &nonholonomic {
+            if c.bodies.len() > MAX_ELEMENT_BODIES {
+                return Err(format!(
+                    "constraint '{}' touches {} bodies (at most {MAX_ELEMENT_BODIES})",
+                    c.name,
+                    c.bodies.len()
+                ));
+            }
+        }
         let mut row = 0;
         for c in constraints.iter_mut().chain(ic_constraints.iter_mut()) {
             c.row = row;
@@ -350,6 +397,8 @@ impl System {
             first_sforce: model.spring_dampers.len(),
             first_gforce: model.spring_dampers.len() + model.sforces.len(),
             first_bushing: model.spring_dampers.len() + model.sforces.len() + model.gforces.len(),
+            nonholonomic,
+            mn,
             user,
             nx,
             nv: model.variables.len(),
@@ -363,6 +412,11 @@ impl System {
             output_bases: model.outputs.iter().map(|o| alloc(&o.function)).collect(),
             lin_states: model
                 .lin_states
+                .iter()
+                .map(|s| (s.name.clone(), s.function.clone(), alloc(&s.function)))
+                .collect(),
+            lin_velocities: model
+                .lin_velocities
                 .iter()
                 .map(|s| (s.name.clone(), s.function.clone(), alloc(&s.function)))
                 .collect(),

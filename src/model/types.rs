@@ -200,6 +200,33 @@ pub struct Bushing {
     pub pos: SrcPos,
 }
 
+/// `<rolling_wheel>`: a thin disc (centre = marker origin, axle = marker z) rolling
+/// without slipping on a plane (marker `plane`: origin on it, z = normal; None: ground z = 0).
+#[derive(Clone, Debug, PartialEq)]
+pub struct RollingWheel {
+    pub name: String,
+    pub marker: MarkerId,
+    pub radius: Num,
+    pub plane: Option<MarkerId>,
+    pub pos: SrcPos,
+}
+
+/// `<knife_edge>`: the marker origin has no velocity along the marker's y axis.
+#[derive(Clone, Debug, PartialEq)]
+pub struct KnifeEdge {
+    pub name: String,
+    pub marker: MarkerId,
+    pub pos: SrcPos,
+}
+
+/// `<velocity_constraint>`: function(q, u, t) = 0, linear in velocities.
+#[derive(Clone, Debug, PartialEq)]
+pub struct VelocityConstraint {
+    pub name: String,
+    pub function: Expr,
+    pub pos: SrcPos,
+}
+
 /// `<variable>`: a user variable V = function (seed Eq. 7b).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Variable {

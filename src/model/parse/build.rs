@@ -88,6 +88,45 @@ impl<'a> Loader<'a> {
                         pos: x.pos,
                     });
                 }
+                "rolling_wheel" => {
+                    let radius = el.num_req("radius")?;
+                    if radius.value.is_nan() || radius.value <= 0.0 {
+                        let at = el.get("radius").map_or(x.pos, |a| a.pos);
+                        return Err(el.err_at(at, format!("radius must be positive (got {})", radius.value)));
+                    }
+                    let marker = marker_ref(&el, "marker")?;
+                    if self.scope.marker_body.get(marker).copied().flatten().is_none() {
+                        return Err(el.err("the wheel marker must be on a body, not on ground"));
+                    }
+                    let plane = opt_marker_ref(&el, "plane")?;
+                    self.model.rolling_wheels.push(RollingWheel {
+                        name: x.label().into(),
+                        marker,
+                        radius,
+                        plane,
+                        pos: x.pos,
+                    });
+                }
+                "knife_edge" => {
+                    let marker = marker_ref(&el, "marker")?;
+                    if self.scope.marker_body.get(marker).copied().flatten().is_none() {
+                        return Err(el.err("the knife-edge marker must be on a body, not on ground"));
+                    }
+                    self.model.knife_edges.push(KnifeEdge { name: x.label().into(), marker, pos: x.pos });
+                }
+                "velocity_constraint" => {
+                    let function = el.expr_req("function")?;
+                    check_deps(&el, "function", &function, Allowed::Velocities)?;
+                    if expr::deps(&function).level == 0 {
+                        let at = el.get("function").map_or(x.pos, |a| a.pos);
+                        return Err(el.err_at(at, "'function' uses no velocities (write a <constraint> instead)"));
+                    }
+                    self.model.velocity_constraints.push(VelocityConstraint {
+                        name: x.label().into(),
+                        function,
+                        pos: x.pos,
+                    });
+                }
                 "variable" => {
                     let function = el.expr_req("function")?;
                     check_deps(&el, "function", &function, Allowed::Force)?;

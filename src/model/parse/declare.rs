@@ -9,7 +9,7 @@ use crate::model::ModelError;
 use crate::model::expr::{ElementRef, NameRef};
 
 /// Elements of the format that this version does not read yet.
-const UNSUPPORTED: &[&str] = &["rolling_wheel", "knife_edge", "velocity_constraint"];
+const UNSUPPORTED: &[&str] = &[];
 
 /// Allowed and required attributes of each supported element.
 pub(crate) fn schema(tag: &str) -> Option<(&'static [&'static str], &'static [&'static str])> {
@@ -37,6 +37,9 @@ pub(crate) fn schema(tag: &str) -> Option<(&'static [&'static str], &'static [&'
         "gforce" => (&["name", "i", "j", "frame", "force", "torque"], &["name", "i"]),
         "bushing" => (&["name", "i", "j", "stiffness", "damping"], &["name", "i", "j", "stiffness"]),
         "variable" => (&["name", "function"], &["name", "function"]),
+        "rolling_wheel" => (&["name", "marker", "radius", "plane"], &["name", "marker", "radius"]),
+        "knife_edge" => (&["name", "marker"], &["name", "marker"]),
+        "velocity_constraint" => (&["name", "function"], &["name", "function"]),
         "differential" => (&["name", "start", "function", "implicit"], &["name", "function"]),
         "input" => (&["name", "start", "unit"], &["name"]),
         "output" => (&["name", "function", "unit"], &["name", "function"]),
@@ -75,6 +78,9 @@ impl<'a> Loader<'a> {
                 "sforce",
                 "gforce",
                 "bushing",
+                "rolling_wheel",
+                "knife_edge",
+                "velocity_constraint",
                 "variable",
                 "differential",
                 "input",
@@ -261,6 +267,13 @@ impl<'a> Loader<'a> {
                     n.bushings += 1;
                     n.forces += 1;
                 }
+                "rolling_wheel" | "knife_edge" | "velocity_constraint" => {
+                    let mut ns = std::mem::take(&mut self.ns_nonholonomic);
+                    let res = self.declare(&mut ns, x, "non-holonomic constraint", n.nonholonomic, false);
+                    self.ns_nonholonomic = ns;
+                    res?;
+                    n.nonholonomic += 1;
+                }
                 "variable" => {
                     self.declare_bare(x, "variable", NameRef::Variable(n.variables))?;
                     n.variables += 1;
@@ -321,6 +334,7 @@ struct Counts {
     sforces: usize,
     gforces: usize,
     bushings: usize,
+    nonholonomic: usize,
     variables: usize,
     diffs: usize,
     forces: usize,

@@ -22,6 +22,7 @@ pub(crate) struct Loader<'a> {
     pub ns_forces: Namespace,
     pub ns_outputs: Namespace,
     pub ns_lin: Namespace,
+    pub ns_nonholonomic: Namespace,
     /// Once-only elements already seen, with their line.
     pub singletons: HashMap<String, usize>,
     pub model: Model,
@@ -44,6 +45,7 @@ pub(crate) fn load(text: &str, file: &str) -> Result<Model, ModelError> {
         ns_forces: Namespace::default(),
         ns_outputs: Namespace::default(),
         ns_lin: Namespace::default(),
+        ns_nonholonomic: Namespace::default(),
         singletons: HashMap::new(),
         model: empty_model(file),
     };
@@ -72,6 +74,9 @@ fn empty_model(file: &str) -> Model {
         bushings: Vec::new(),
         variables: Vec::new(),
         differentials: Vec::new(),
+        rolling_wheels: Vec::new(),
+        knife_edges: Vec::new(),
+        velocity_constraints: Vec::new(),
         inputs: Vec::new(),
         outputs: Vec::new(),
         lin_states: Vec::new(),

@@ -14,10 +14,13 @@ pub struct Summary {
     pub bodies: usize,
     /// 6 · bodies.
     pub coordinates: usize,
-    /// Joint equations + motions + user constraints.
+    /// Holonomic equations: joints + motions + user constraints + wheel contacts.
     pub constraints: usize,
     /// coordinates − constraints.
     pub dof: isize,
+    /// Non-holonomic equations (2 per rolling wheel, 1 per knife edge and velocity
+    /// constraint): velocity-level degrees of freedom = dof − this.
+    pub nonholonomic: usize,
 }
 
 impl fmt::Display for Summary {
@@ -26,7 +29,16 @@ impl fmt::Display for Summary {
             f,
             "{} bodies, {} coordinates, {} constraint equations, {} degrees of freedom",
             self.bodies, self.coordinates, self.constraints, self.dof
-        )
+        )?;
+        if self.nonholonomic > 0 {
+            write!(
+                f,
+                "; {} non-holonomic equations, {} velocity degrees of freedom",
+                self.nonholonomic,
+                self.dof - self.nonholonomic as isize
+            )?;
+        }
+        Ok(())
     }
 }
 
@@ -134,9 +146,12 @@ impl Model {
     pub fn summary(&self) -> Summary {
         let bodies = self.bodies.len();
         let coordinates = 6 * bodies;
-        let constraints =
-            self.joints.iter().map(|j| j.kind.equations()).sum::<usize>() + self.motions.len() + self.constraints.len();
+        let constraints = self.joints.iter().map(|j| j.kind.equations()).sum::<usize>()
+            + self.motions.len()
+            + self.constraints.len()
+            + self.rolling_wheels.len();
         let dof = coordinates as isize - constraints as isize;
-        Summary { bodies, coordinates, constraints, dof }
+        let nonholonomic = 2 * self.rolling_wheels.len() + self.knife_edges.len() + self.velocity_constraints.len();
+        Summary { bodies, coordinates, constraints, dof, nonholonomic }
     }
 }

@@ -1,0 +1,139 @@
+//! Velocity-level state selection (the seed's closing remark on non-holonomic systems):
+//! with non-holonomic constraints there are s1 = s0 − (non-holonomic equations) velocity
+//! states W, chosen separately from the position states S by the same weighted full-pivot
+//! factorization (Eq. 33), written in q̇: J1 = [C_q 0; B T 0; −w_q̇ D] with u = T(q) q̇.
+//! Candidates: user `<velocity>` expressions (weighted most), the time derivatives of the
+//! user position states, then every q̇_i (`der(body.x)` ...).
+
+use super::jets::jets;
+use super::select::{D_SMALL, RANK_TOL, USER_ROW_WEIGHT};
+use super::states::{StateFn, VelState, internal_state, user_states, user_velocities};
+use crate::dae::equations::nonholonomic_b;
+use crate::mechanics::System;
+use crate::mechanics::body::NQ;
+use crate::mechanics::kernels::constraint_first;
+use faer::Mat;
+
+/// Preference of explicit `<velocity>` candidates over derivatives of user position states:
+/// their rows weigh this much more and their D entries this much less, so full pivoting
+/// eliminates them first and, between two dependent candidates, pivots (drops) the other.
+const VELOCITY_PREFERENCE: f64 = 10.0;
+
+/// Row `r` (u-space, global) times T(q): the same row in q̇-space (T = H⁻¹ per body).
+fn times_t(q: &[f64], r: &mut [f64]) {
+    for b in 0..q.len() / NQ {
+        let o = NQ * b;
+        let (st, ct, sp, cp) = (q[o + 4].sin(), q[o + 4].cos(), q[o + 5].sin(), q[o + 5].cos());
+        let t = [[st * sp, cp, 0.0], [st * cp, -sp, 0.0], [ct, 0.0, 1.0]];
+        let w = [r[o + 3], r[o + 4], r[o + 5]];
+        for c in 0..3 {
+            r[o + 3 + c] = (0..3).map(|k| w[k] * t[k][c]).sum();
+        }
+    }
+}
+
+/// Choose the velocity states W at (q, u, t) given the position selection `states`.
+pub fn select_velocities(
+    sys: &System,
+    q: &[f64],
+    u: &[f64],
+    t: f64,
+    ext: &[f64],
+) -> Result<(Vec<VelState>, Vec<String>), String> {
+    let n = sys.n();
+    let zeros = vec![0.0; n];
+    // (candidate, its q̇-row, row weight, its D entry)
+    let mut cands: Vec<(VelState, Vec<f64>, f64, f64)> = Vec::new();
+    for v in user_velocities(sys) {
+        let j = &jets(sys, &v, q, u, &zeros, t, ext)[0];
+        let nql = NQ * v.bodies.len();
+        let mut row = vec![0.0; n];
+        for a in 0..nql {
+            row[NQ * v.bodies[a / NQ] + a % NQ] = j.dg[nql + a];
+        }
+        times_t(q, &mut row);
+        cands.push((VelState::User(v), row, USER_ROW_WEIGHT * VELOCITY_PREFERENCE, D_SMALL / VELOCITY_PREFERENCE));
+    }
+    for s in user_states(sys) {
+        let j = &jets(sys, &s, q, u, &zeros, t, ext)[0];
+        let mut row = vec![0.0; n];
+        for (a, &b) in s.bodies.iter().enumerate() {
+            for c in 0..NQ {
+                row[NQ * b + c] = j.dg[NQ * a + c];
+            }
+        }
+        cands.push((VelState::Derivative(s), row, USER_ROW_WEIGHT, D_SMALL));
+    }
+    let nc = cands.len();
+    let mut rows: Vec<Vec<f64>> = Vec::new();
+    for el in &sys.constraints {
+        let f = constraint_first(sys, el, q, t, ext);
+        let nql = NQ * el.bodies.len();
+        for e in 0..el.neq {
+            if sys.redundant[el.row + e] {
+                continue;
+            }
+            let mut row = vec![0.0; n];
+            for a in 0..nql {
+                row[NQ * el.bodies[a / NQ] + a % NQ] += f.cq[e * nql + a];
+            }
+            rows.push(row);
+        }
+    }
+    let (b, _) = nonholonomic_b(sys, q, u, t, ext);
+    let mut brows = vec![vec![0.0; n]; sys.mn];
+    for (r, c, v) in b {
+        brows[r][c] += v;
+    }
+    for mut row in brows {
+        times_t(q, &mut row);
+        rows.push(row);
+    }
+    let nr = rows.len();
+    let mut j = Mat::<f64>::zeros(nr + nc, n + nc);
+    for (r, row) in rows.iter().enumerate() {
+        for (c, &v) in row.iter().enumerate() {
+            j[(r, c)] = v;
+        }
+    }
+    for (k, (_, row, w, dk)) in cands.iter().enumerate() {
+        if row.iter().any(|v| !v.is_finite()) {
+            return Err(format!("velocity candidate '{}' has no finite derivative here", cands[k].0.name()));
+        }
+        for (c, &v) in row.iter().enumerate() {
+            j[(nr + k, c)] = -w * v;
+        }
+        j[(nr + k, n + k)] = w * dk;
+    }
+    let lu = j.full_piv_lu();
+    let uu = lu.U();
+    let kmin = (nr + nc).min(n + nc);
+    // Every candidate row has its own D column, so J1 has full row rank exactly when the
+    // (independent) holonomic rows and the non-holonomic rows are independent together.
+    let big = (0..kmin).map(|i| uu[(i, i)].abs()).fold(0.0, f64::max).max(1.0);
+    let rank = nr + nc;
+
+    if (0..rank).any(|i| uu[(i, i)].abs() <= RANK_TOL * RANK_TOL * big) {
+        return Err("the non-holonomic constraints are not independent of the others".into());
+    }
+    let perm = lu.Q().arrays().0.to_vec();
+    let free = &perm[rank..];
+    let mut out: Vec<VelState> = Vec::new();
+    let mut dropped = Vec::new();
+    for (k, (c, _, _, _)) in cands.into_iter().enumerate() {
+        if free.contains(&(n + k)) {
+            out.push(c);
+        } else {
+            dropped.push(c.name());
+        }
+    }
+    let mut internal: Vec<usize> = free.iter().copied().filter(|&c| c < n).collect();
+    internal.sort_unstable();
+    out.extend(internal.into_iter().map(|c| VelState::Derivative(internal_state(sys, c))));
+    Ok((out, dropped))
+}
+
+/// W = Ṡ for every position state (no non-holonomic constraints: s1 = s0).
+pub fn derivative_states(states: &[StateFn]) -> Vec<VelState> {
+    states.iter().cloned().map(VelState::Derivative).collect()
+}
