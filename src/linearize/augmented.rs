@@ -288,12 +288,14 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
     let pick = |r: usize, c: usize| if r < s { rhs[(bl.sd() + r, c)] } else { rhs[(bl.wd() + r - s, c)] };
     let a = Mat::from_fn(2 * s, 2 * s, pick);
     let b = Mat::from_fn(2 * s, ni, |r, c| pick(r, 2 * s + c));
-    // C and D: chain rule through q, u, u̇ sensitivities.
+    // C and D: chain rule through the q, u, u̇ and λ sensitivities (solution rows of Eq. 34;
+    // λ enters through element loads).
     let no = sys.outputs.len();
     let mut c = Mat::<f64>::zeros(no, 2 * s);
     let mut d = Mat::<f64>::zeros(no, ni);
+    let point = super::outputs::Point { q: &q, u: &u, udot: &udot, lam: &lam, t, inputs: &inputs };
     for (o, (e, &abase)) in sys.outputs.iter().zip(&sys.output_bases).enumerate() {
-        let g = output_gradient(sys, e, abase, &q, &u, &udot, t, &inputs);
+        let g = output_gradient(sys, e, abase, point);
         let nql = NQ * g.bodies.len();
         let sens = |col: usize| -> f64 {
             let mut v = 0.0;
@@ -302,6 +304,9 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
                 v += g.dz[a] * rhs[(bl.q() + gi, col)]
                     + g.dz[nql + a] * rhs[(bl.u() + gi, col)]
                     + g.dz[2 * nql + a] * rhs[(bl.ud() + gi, col)];
+            }
+            for &(row, w) in &g.dlam {
+                v += w * rhs[(bl.lam() + row, col)];
             }
             v
         };
@@ -313,7 +318,7 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
         }
         if (0..2 * s).any(|col| !c[(o, col)].is_finite()) || (0..ni).any(|v| !d[(o, v)].is_finite()) {
             return Err(EngineError::Numeric(format!(
-                "output '{}' has no finite derivative here (e.g. |v| at v = 0, or element loads, which are not differentiated yet)",
+                "output '{}' has no finite derivative here (e.g. |v| at v = 0, or the load of a user constraint)",
                 sys.output_names[o]
             )));
         }

@@ -7,6 +7,7 @@ pub mod body;
 pub mod constraints;
 pub mod forces;
 pub mod kernels;
+pub mod loads;
 pub mod local;
 pub mod system;
 
