@@ -288,8 +288,21 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
     let pick = |r: usize, c: usize| if r < s { rhs[(bl.sd() + r, c)] } else { rhs[(bl.wd() + r - s, c)] };
     let a = Mat::from_fn(2 * s, 2 * s, pick);
     let b = Mat::from_fn(2 * s, ni, |r, c| pick(r, 2 * s + c));
+    // Ṡ = W (Eq. 34g): the Ṡ rows of A and B are exactly [0 I] and 0, without the LU's
+    // round-off (so the FMU's structural zeros are zeros).
+    let (mut a, mut b) = (a, b);
+    for r in 0..s {
+        for col in 0..2 * s {
+            a[(r, col)] = if col == s + r { 1.0 } else { 0.0 };
+        }
+        for v in 0..ni {
+            b[(r, v)] = 0.0;
+        }
+    }
     // C and D: chain rule through the q, u, u̇ and λ sensitivities (solution rows of Eq. 34;
-    // λ enters through element loads).
+    // λ enters through element loads). Positions and velocities do not depend on the
+    // inputs (Eq. 34d–f, h, j–k hold no input terms), so D takes only the u̇ and λ terms:
+    // the others are zero, and would carry only the LU's round-off.
     let no = sys.outputs.len();
     let mut c = Mat::<f64>::zeros(no, 2 * s);
     let mut d = Mat::<f64>::zeros(no, ni);
@@ -298,12 +311,14 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
         let g = output_gradient(sys, e, abase, point);
         let nql = NQ * g.bodies.len();
         let sens = |col: usize| -> f64 {
+            let kinematic = col < 2 * s;
             let mut v = 0.0;
             for a in 0..nql {
                 let gi = NQ * g.bodies[a / NQ] + a % NQ;
-                v += g.dz[a] * rhs[(bl.q() + gi, col)]
-                    + g.dz[nql + a] * rhs[(bl.u() + gi, col)]
-                    + g.dz[2 * nql + a] * rhs[(bl.ud() + gi, col)];
+                if kinematic {
+                    v += g.dz[a] * rhs[(bl.q() + gi, col)] + g.dz[nql + a] * rhs[(bl.u() + gi, col)];
+                }
+                v += g.dz[2 * nql + a] * rhs[(bl.ud() + gi, col)];
             }
             for &(row, w) in &g.dlam {
                 v += w * rhs[(bl.lam() + row, col)];

@@ -4,6 +4,7 @@
 //! from [`crate::ad::Dual`] numbers through the kernels in [`kernels`].
 
 pub mod body;
+pub mod components;
 pub mod constraints;
 pub mod forces;
 pub mod kernels;
