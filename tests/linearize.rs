@@ -1,17 +1,12 @@
 //! Exact linearization (Eq. 34) against analytic results and against central differences
 //! of the engine's own state-space equations (tests only).
 
-use faer::linalg::solvers::Solve;
-use mbfmu::dae::init::accelerations;
-use mbfmu::dae::sparse::SparseLu;
+mod common;
+
+use common::state_space;
 use mbfmu::dae::{SimOptions, Simulator};
 use mbfmu::linearize::eigen::eigen_table;
-use mbfmu::linearize::jets::{PositionFn, jets};
-use mbfmu::linearize::outputs::output_gradient;
 use mbfmu::linearize::{linearize, select_states};
-use mbfmu::mechanics::System;
-use mbfmu::mechanics::body::NQ;
-use mbfmu::mechanics::kernels::constraint_first;
 use mbfmu::model::Model;
 use mbfmu::model::parse::load_str;
 
@@ -150,82 +145,6 @@ fn singular_partition_is_reported_not_returned_as_a_matrix() {
     sim.advance(std::f64::consts::FRAC_PI_2).unwrap();
     let err = linearize(&mut sim, &sel, 1).err().map(|e| e.to_string()).unwrap_or_default();
     assert!(err.contains("no longer parameterize"), "{err}");
-}
-
-/// The engine's state-space map x = (S, W), v ↦ (Ṡ, Ẇ, y): q from C(q) = 0, s(q) = S by
-/// Newton; u from P u + C_t = 0, ṡ(q, u) = W; u̇ from the equations of motion.
-fn state_space(
-    sys: &System,
-    sel: &mbfmu::linearize::Selection,
-    q0: &[f64],
-    t: f64,
-    x: &[f64],
-    v: &[f64],
-) -> (Vec<f64>, Vec<f64>) {
-    let (n, m, s) = (sys.n(), sys.m, sel.states.len());
-    let zeros = vec![0.0; n];
-    let mut q = q0.to_vec();
-    let square = |q: &[f64], u: &[f64], level: usize| -> (Vec<f64>, Vec<f64>) {
-        // Rows: constraints (level 0: C, level 1: Ċ), then states (s or ṡ); columns: q or u.
-        let mut mat = vec![0.0; n * n];
-        let mut r = vec![0.0; n];
-        for el in &sys.constraints {
-            let js = jets(sys, el, q, u, &zeros, t, v);
-            for (e, j) in js.iter().enumerate() {
-                let row = el.row + e;
-                r[row] = if level == 0 { j.g } else { j.g1 };
-                let g = if level == 0 { &j.dg } else { &j.dg1 };
-                let nql = NQ * el.bodies().len();
-                for a in 0..nql {
-                    mat[row * n + NQ * el.bodies()[a / NQ] + a % NQ] += g[if level == 0 { a } else { nql + a }];
-                }
-            }
-        }
-        for (k, st) in sel.states.iter().enumerate() {
-            let j = &jets(sys, st, q, u, &zeros, t, v)[0];
-            r[m + k] = if level == 0 { j.g - x[k] } else { j.g1 - x[s + k] };
-            let g = if level == 0 { &j.dg } else { &j.dg1 };
-            let nql = NQ * st.bodies().len();
-            for a in 0..nql {
-                mat[(m + k) * n + NQ * st.bodies()[a / NQ] + a % NQ] += g[if level == 0 { a } else { nql + a }];
-            }
-        }
-        (mat, r)
-    };
-    let solve = |mat: &[f64], r: &[f64]| -> Vec<f64> {
-        let a = faer::Mat::from_fn(n, n, |i, j| mat[i * n + j]);
-        let b = faer::Mat::from_fn(n, 1, |i, _| r[i]);
-        let sol = a.full_piv_lu().solve(&b);
-        (0..n).map(|i| sol[(i, 0)]).collect()
-    };
-    for _ in 0..30 {
-        let (mat, r) = square(&q, &zeros, 0);
-        let dq = solve(&mat, &r);
-        for i in 0..n {
-            q[i] -= dq[i];
-        }
-        if dq.iter().all(|d| d.abs() < 1e-15) {
-            break;
-        }
-    }
-    // ṡ and Ċ are affine in u: residual at u = 0, matrix = their u-gradients.
-    let (mat, r) = square(&q, &zeros, 1);
-    let u: Vec<f64> = solve(&mat, &r).iter().map(|x| -x).collect();
-    let (udot, _) = accelerations(sys, &q, &u, t, v, &mut SparseLu::new()).unwrap();
-    let mut xd = x[s..].to_vec();
-    for st in &sel.states {
-        xd.push(jets(sys, st, &q, &u, &udot, t, v)[0].g2);
-    }
-    let y = (0..sys.outputs.len())
-        .map(|o| {
-            let _ = output_gradient;
-            let ids: Vec<usize> = (0..sys.nb()).collect();
-            let ctx = mbfmu::mechanics::local::LocalCtx::new(sys, &ids, &q, &u, &udot, t, v);
-            ctx.eval_expr(&sys.outputs[o], sys.output_bases[o])
-        })
-        .collect();
-    let _ = constraint_first;
-    (xd, y)
 }
 
 const ARM: &str = r#"<multibody name="arm" version="1">

@@ -7,6 +7,7 @@ use super::sparse::{SparseLu, Triplets};
 use crate::geom::{M3, V3, rot313};
 use crate::mechanics::System;
 use crate::mechanics::body::{NQ, body_frame};
+use crate::mechanics::loads::{load_index, load_value};
 use crate::mechanics::local::LocalCtx;
 use crate::mechanics::system::{FAR_FROM_SINGULAR, rebased_reference};
 use crate::model::expr::{ElementRef, LoadFn};
@@ -365,63 +366,11 @@ impl Simulator {
         Ok(sys.outputs.iter().zip(&sys.output_bases).map(|(e, &b)| ctx.eval_expr(e, b)).collect())
     }
 
-    /// Component `f` of the load element `e` applies on its i marker (NaN if it has none).
+    /// Component `f` of the load element `e` applies on its i marker (NaN if it has none),
+    /// from [`crate::mechanics::loads`].
     fn load_component(&self, f: LoadFn, e: ElementRef, lam: &[f64]) -> f64 {
-        self.element_load(e, lam).map_or(f64::NAN, |(fo, to)| pick(f, fo, to))
-    }
-
-    /// Force and torque (ground; torque about the i marker origin) that an element
-    /// applies on its i marker, evaluated on the element's own bodies.
-    fn element_load(&self, e: ElementRef, lam: &[f64]) -> Option<([f64; 3], [f64; 3])> {
-        use crate::mechanics::constraints::ConstraintKind;
-        use crate::mechanics::kernels::{constraint_first, gather};
-        use crate::mechanics::system::ElementSlot;
-        let sys = &self.dae.sys;
-        let (q, u, t) = (self.q(), self.u(), self.radau.t);
-        let inputs = self.ext();
-        let el = match sys.element_slot(e) {
-            ElementSlot::Force(k) => {
-                let el = sys.forces.get(k)?;
-                let (ql, ul) = (gather(&el.bodies, q), gather(&el.bodies, u));
-                let l = el.load(&LocalCtx::new(sys, &el.bodies, &ql, &ul, &[], t, &inputs));
-                return Some((l.force.val(), l.torque.val()));
-            }
-            ElementSlot::Constraint(k) => sys.constraints.get(k)?,
-        };
-        let f = constraint_first(sys, el, q, t, &inputs);
-        let nql = NQ * el.bodies.len();
-        let mut genf = vec![0.0; nql];
-        for e in 0..el.neq {
-            let p = equations::p_row(&el.bodies, q, &f.cq[e * nql..(e + 1) * nql]);
-            for a in 0..nql {
-                genf[a] -= p[a] * lam[el.row + e];
-            }
-        }
-        let (mi, mj) = match &el.kind {
-            ConstraintKind::Joint { i, j, .. }
-            | ConstraintKind::Rotation { i, j, .. }
-            | ConstraintKind::Translation { i, j, .. } => (*i, Some(*j)),
-            ConstraintKind::User { .. } | ConstraintKind::WheelContact { .. } => return None,
-        };
-        let ql = gather(&el.bodies, q);
-        let pi = ctx_pose(&LocalCtx::new(sys, &el.bodies, &ql, &[], &[], t, &inputs), mi);
-        // Reaction on a body, moved to the point p_i.
-        let on_body = |b: usize| -> ([f64; 3], [f64; 3]) {
-            let k = el.bodies.iter().position(|&x| x == b).expect("element body");
-            let (r, a) = body_frame(&q[NQ * b..NQ * b + NQ], &sys.r0[b]);
-            let fo = V3([genf[NQ * k], genf[NQ * k + 1], genf[NQ * k + 2]]);
-            let tc = a.mv(&V3([genf[NQ * k + 3], genf[NQ * k + 4], genf[NQ * k + 5]]));
-            let ti = tc - (pi - r).cross(&fo);
-            (fo.0, ti.0)
-        };
-        match (sys.markers[mi].body, mj.and_then(|j| sys.markers[j].body)) {
-            (Some(b), _) => Some(on_body(b)),
-            (None, Some(b)) => {
-                let (fo, to) = on_body(b);
-                Some((fo.map(|x| -x), to.map(|x| -x)))
-            }
-            _ => None,
-        }
+        let t = self.radau.t;
+        load_value(&self.dae.sys, e, (self.q(), self.u(), lam), t, &self.ext()).map_or(f64::NAN, |l| l[load_index(f)])
     }
 
     /// Largest |g_i(q, u, t)| over the non-holonomic constraints at the current time.
@@ -554,7 +503,7 @@ impl Simulator {
     /// accelerations also need the jerk, taken from the integrator's collocation polynomial
     /// over the last step (zero right after a state was restored); loads count as constant.
     pub fn output_derivatives(&mut self) -> Result<Vec<f64>, EngineError> {
-        use crate::ad::Dual;
+        use crate::ad::{Dual, Real};
         type D = Dual<f64, 1>;
         let (udot, lam) = self.accelerations()?;
         let n = self.dae.lay.n;
@@ -579,7 +528,7 @@ impl Simulator {
         }
         let sys = &self.dae.sys;
         let ids: Vec<usize> = (0..sys.nb()).collect();
-        let ctx_loads = |f: LoadFn, e: ElementRef| self.load_component(f, e, &lam);
+        let ctx_loads = |f: LoadFn, e: ElementRef| D::cst(self.load_component(f, e, &lam));
         let mut ctx = LocalCtx::new(sys, &ids, &qv, &uv, &av, D { v: t, d: [1.0] }, &inputs);
         ctx.input_values = Some(mk(&inputs, &rates));
         ctx.loads = Some(&ctx_loads);
@@ -628,21 +577,5 @@ impl Simulator {
         let t = self.radau.t;
         self.dae.inputs = self.dae.inputs_at(t);
         self.dae.t_in = t;
-    }
-}
-
-fn ctx_pose(ctx: &LocalCtx<f64>, m: usize) -> V3<f64> {
-    use crate::model::expr::ExprEnv;
-    ctx.pose(m).p
-}
-
-fn pick(f: LoadFn, fo: [f64; 3], to: [f64; 3]) -> f64 {
-    match f {
-        LoadFn::Fx => fo[0],
-        LoadFn::Fy => fo[1],
-        LoadFn::Fz => fo[2],
-        LoadFn::Tx => to[0],
-        LoadFn::Ty => to[1],
-        LoadFn::Tz => to[2],
     }
 }

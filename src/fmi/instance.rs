@@ -144,7 +144,16 @@ impl Instance {
         }
         let names: Vec<String> =
             self.vars.iter().filter(|v| matches!(v.target, Target::State(_))).map(|v| v.name.clone()).collect();
-        let sel = selection_by_name(sim.system(), &names);
+        // Velocity states W_j, in j order: der(S_k) variables that are states, and the others.
+        let mut w: Vec<(usize, String)> = self
+            .vars
+            .iter()
+            .filter(|v| matches!(v.target, Target::StateDerivative(_) | Target::Velocity(_)))
+            .filter_map(|v| v.known.map(|c| (c - names.len(), v.name.clone())))
+            .collect();
+        w.sort();
+        let w_names: Vec<String> = w.into_iter().map(|(_, n)| n).collect();
+        let sel = selection_by_name(sim.system(), &names, &w_names);
         Ok(Built { sim, params: cfg.params.clone(), tol: cfg.tol, sel, lin: None })
     }
 
@@ -153,7 +162,7 @@ impl Instance {
         let targets = vrs.iter().map(|&vr| Ok(self.var(vr)?.target)).collect::<Result<Vec<Target>, String>>()?;
         let mut outputs = None;
         let mut inputs = None;
-        let mut states: Option<[Vec<f64>; 3]> = None;
+        let mut states: Option<crate::linearize::StateValues> = None;
         for (t, o) in targets.iter().zip(out.iter_mut()) {
             *o = match *t {
                 Target::Parameter(k) => self.config.params[k],
@@ -168,7 +177,7 @@ impl Instance {
                     }
                     outputs.as_ref().expect("evaluated")[k]
                 }
-                Target::State(k) | Target::StateDerivative(k) | Target::StateSecondDerivative(k) => {
+                Target::State(k) | Target::StateDerivative(k) | Target::Velocity(k) | Target::VelocityDerivative(k) => {
                     if states.is_none() {
                         self.simulator()?;
                         let b = self.built.as_mut().expect("built");
@@ -179,9 +188,10 @@ impl Instance {
                     }
                     let v = states.as_ref().expect("evaluated");
                     match *t {
-                        Target::State(_) => v[0][k],
-                        Target::StateDerivative(_) => v[1][k],
-                        _ => v[2][k],
+                        Target::State(_) => v.s[k],
+                        Target::StateDerivative(_) => v.sd[k],
+                        Target::Velocity(_) => v.w[k],
+                        _ => v.wd[k],
                     }
                 }
                 Target::Diff(k) | Target::DiffDerivative(k) | Target::UserVariable(k) => {
@@ -214,7 +224,7 @@ impl Instance {
             }
             match var.target {
                 Target::Output(_) => return Err(format!("'{}' (vr {vr}) is an output and cannot be set", var.name)),
-                Target::State(_) | Target::StateDerivative(_) | Target::StateSecondDerivative(_) => {
+                Target::State(_) | Target::StateDerivative(_) | Target::Velocity(_) | Target::VelocityDerivative(_) => {
                     return Err(format!(
                         "'{}' (vr {vr}) is a linearization state (computed from the motion) and cannot be set",
                         var.name
@@ -277,48 +287,36 @@ impl Instance {
         dv: &[f64],
         out: &mut [f64],
     ) -> Result<(), String> {
-        let nx = self.vars.iter().filter(|v| matches!(v.target, Target::Diff(_))).count();
-        // Columns of A/C: S, W, X; then inputs (B/D).
-        let col = |t: Target, s: usize| match t {
-            Target::State(k) => Some(k),
-            Target::StateDerivative(k) => Some(s + k),
-            Target::Diff(k) => Some(2 * s + k),
-            Target::Input(i) => Some(2 * s + nx + i),
-            _ => None,
+        // Columns of A/C: S, W, X (the variables' `known`); then inputs (B/D). Rows: Ṡ, Ẇ, Ẋ
+        // (`unknown`), then outputs.
+        let ns = self.vars.iter().filter(|v| v.known.is_some()).count();
+        let col = |v: &Variable| match v.target {
+            Target::Input(i) => Some(ns + i),
+            _ => v.known,
         };
-        let row = |t: Target, s: usize| match t {
-            Target::StateDerivative(k) => Some((false, k)),
-            Target::StateSecondDerivative(k) => Some((false, s + k)),
-            Target::DiffDerivative(k) => Some((false, 2 * s + k)),
+        let row = |v: &Variable| match v.target {
             Target::Output(o) => Some((true, o)),
-            _ => None,
+            _ => v.unknown.map(|r| (false, r)),
         };
-        let kt: Vec<(u32, Target)> =
-            knowns.iter().map(|&vr| Ok((vr, self.var(vr)?.target))).collect::<Result<_, String>>()?;
-        let ut: Vec<(u32, Target)> =
-            unknowns.iter().map(|&vr| Ok((vr, self.var(vr)?.target))).collect::<Result<_, String>>()?;
-        let names = |vr: u32| self.var(vr).map(|v| v.name.clone()).unwrap_or_default();
-        let s = self.vars.iter().filter(|v| matches!(v.target, Target::State(_))).count();
-        for &(vr, t) in &kt {
-            if col(t, s).is_none() {
-                return Err(format!("known '{}' (vr {vr}) is neither a state nor an input", names(vr)));
-            }
+        let mut kc = Vec::with_capacity(knowns.len());
+        for &vr in knowns {
+            let v = self.var(vr)?;
+            kc.push(col(v).ok_or_else(|| format!("known '{}' (vr {vr}) is neither a state nor an input", v.name))?);
         }
-        for &(vr, t) in &ut {
-            if row(t, s).is_none() {
-                return Err(format!("unknown '{}' (vr {vr}) is neither a state derivative nor an output", names(vr)));
-            }
+        let mut ur = Vec::with_capacity(unknowns.len());
+        for &vr in unknowns {
+            let v = self.var(vr)?;
+            ur.push(row(v).ok_or_else(|| {
+                format!("unknown '{}' (vr {vr}) is neither a state derivative nor an output", v.name)
+            })?);
         }
         if let Some(v) = dv.iter().find(|v| !v.is_finite()) {
             return Err(format!("seed value {v} is not finite"));
         }
         let lin = self.linearization()?;
-        for (o, &(_, t)) in out.iter_mut().zip(&ut) {
-            let (is_output, r) = row(t, s).expect("checked");
+        for (o, &(is_output, r)) in out.iter_mut().zip(&ur) {
             let mut acc = 0.0;
-            for (&(_, k), &d) in kt.iter().zip(dv) {
-                let c = col(k, s).expect("checked");
-                let ns = 2 * s + nx;
+            for (&c, &d) in kc.iter().zip(dv) {
                 acc += d * match (is_output, c < ns) {
                     (false, true) => lin.a[(r, c)],
                     (false, false) => lin.b[(r, c - ns)],

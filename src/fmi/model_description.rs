@@ -1,25 +1,22 @@
 //! `modelDescription.xml` of a model's FMI 2.0 Co-Simulation FMU.
 //!
 //! The variables and their value references come from [`super::variables`] (shared with
-//! the C API). Dependencies in `<ModelStructure>` are derived from the output expressions:
-//!
-//! - At communication points (`<Outputs>`) the knowns are the inputs (no states are
-//!   exposed). Positions and velocities are states of the integrator, so an output depends
-//!   on an input only through the input's direct use in the output, through the loads of
-//!   force elements whose functions use it, or through accelerations (an acceleration
-//!   measure or a joint, motion or constraint load): then on every input that a force uses.
-//! - In Initialization Mode (`<InitialUnknowns>`) the knowns are also the parameters
-//!   (`initial="exact"`): setting one re-evaluates the whole model, so every output depends
-//!   on every parameter, and with `<analysis static="true"/>` the equilibrium positions
-//!   depend on every input a force uses.
+//! the C API). Dependencies in `<ModelStructure>` are structural (see
+//! [`super::dependencies`]): at communication points the knowns are the states S, W and
+//! the inputs, and each unknown lists only those of its own mechanism (connected
+//! component) that it can depend on. In Initialization Mode (`<InitialUnknowns>`) the
+//! knowns are also the parameters (`initial="exact"`): setting one re-evaluates the whole
+//! model, so every unknown depends on every parameter, and with
+//! `<analysis static="true"/>` the equilibrium positions depend on every input a force
+//! uses.
 
 use std::collections::BTreeSet;
 use std::fmt::Write as _;
 
+use super::dependencies::{Dependencies, Structure};
 use super::guid::{ENGINE_VERSION, guid, model_identifier};
 use super::variables::{Causality, Target, Variable, variables};
 use crate::model::Model;
-use crate::model::expr::{ElementRef, Expr, deps};
 
 /// The modelDescription.xml of the FMU of `model`, whose file text is `model_text` (it
 /// determines the GUID, see [`guid`]).
@@ -224,63 +221,6 @@ fn write_variable(x: &mut String, index: usize, v: &Variable) {
     x.push_str("/>\n    </ScalarVariable>\n");
 }
 
-/// Inputs used by force elements: accelerations and constraint loads depend on these.
-fn force_inputs(model: &Model) -> BTreeSet<usize> {
-    let mut s = BTreeSet::new();
-    for f in &model.sforces {
-        s.extend(deps(&f.function).inputs);
-    }
-    for g in &model.gforces {
-        for e in g.force.iter().chain(&g.torque) {
-            s.extend(deps(e).inputs);
-        }
-    }
-    s.extend(user_inputs(model));
-    s
-}
-
-/// Inputs read by user variables and differentials (which forces and outputs may read).
-fn user_inputs(model: &Model) -> BTreeSet<usize> {
-    let mut s = BTreeSet::new();
-    for e in model.variables.iter().map(|v| &v.function).chain(model.differentials.iter().map(|d| &d.function)) {
-        s.extend(deps(e).inputs);
-    }
-    s
-}
-
-/// Inputs (indices into `Model::inputs`) that an output expression depends on at a
-/// communication point; see the module documentation.
-pub fn output_input_deps(model: &Model, e: &Expr) -> BTreeSet<usize> {
-    let d = deps(e);
-    let mut s: BTreeSet<usize> = d.inputs.iter().copied().collect();
-    let mut through_accelerations = d.level >= 2;
-    if !(d.variables.is_empty() && d.diff_dots.is_empty()) {
-        s.extend(user_inputs(model));
-    }
-    for r in &d.loads {
-        match *r {
-            ElementRef::Joint(_) | ElementRef::Motion(_) | ElementRef::Constraint(_) => through_accelerations = true,
-            ElementRef::SpringDamper(_) | ElementRef::Bushing(_) => {}
-            ElementRef::Sforce(k) => {
-                if let Some(f) = model.sforces.get(k) {
-                    s.extend(deps(&f.function).inputs);
-                }
-            }
-            ElementRef::Gforce(k) => {
-                if let Some(g) = model.gforces.get(k) {
-                    for e in g.force.iter().chain(&g.torque) {
-                        s.extend(deps(e).inputs);
-                    }
-                }
-            }
-        }
-    }
-    if through_accelerations {
-        s.extend(force_inputs(model));
-    }
-    s
-}
-
 /// `<Unknown index dependencies dependenciesKind/>` with 1-based `deps`.
 fn unknown(x: &mut String, index: usize, deps: &BTreeSet<usize>) {
     let list: Vec<String> = deps.iter().map(|d| d.to_string()).collect();
@@ -297,43 +237,77 @@ fn write_structure(x: &mut String, model: &Model, vars: &[Variable]) {
     // FMI index (1-based ModelVariables position) of each parameter, input and state.
     let mut param_index = Vec::new();
     let mut input_index = vec![0; model.inputs.len()];
-    let mut state_index = BTreeSet::new();
-    let mut unknowns = Vec::new(); // (index, dependencies at communication points)
+    let (mut s_index, mut w_index) = (Vec::new(), Vec::new());
+    let mut state_index: BTreeSet<usize> = BTreeSet::new();
     for (k, v) in vars.iter().enumerate() {
         match v.target {
             Target::Parameter(_) => param_index.push(k + 1),
             Target::Input(i) => input_index[i] = k + 1,
-            Target::State(_) | Target::StateDerivative(_) | Target::Diff(_) => {
-                state_index.insert(k + 1);
-            }
+            Target::State(_) => s_index.push(k + 1),
+            Target::StateDerivative(_) if v.known.is_some() => w_index.push(k + 1),
             _ => {}
         }
+        if v.known.is_some() {
+            state_index.insert(k + 1);
+        }
     }
-    let to_fmi =
-        |s: &BTreeSet<usize>| -> BTreeSet<usize> { s.iter().filter_map(|i| input_index.get(*i).copied()).collect() };
+    let structure = Structure::of(model);
+    let global = structure.is_global();
+    let inputs_fmi = |d: &Dependencies| -> BTreeSet<usize> {
+        d.inputs.iter().filter_map(|i| input_index.get(*i).copied()).collect()
+    };
+    // FMI indices of a dependency set: S_k and W_k (paired without non-holonomic
+    // constraints) and inputs; in global mode every state.
+    let to_fmi = |d: &Dependencies| -> BTreeSet<usize> {
+        let mut out = inputs_fmi(d);
+        if global {
+            out.extend(&state_index);
+        } else {
+            out.extend(d.states.iter().flat_map(|&k| [s_index.get(k), w_index.get(k)]).flatten().copied());
+        }
+        out
+    };
+    let all_forces = Dependencies { states: (0..s_index.len()).collect(), inputs: structure.force_inputs().clone() };
+    let mut unknowns = Vec::new(); // (index, dependencies at communication points)
     let mut derivatives = Vec::new();
     for (k, v) in vars.iter().enumerate() {
         match v.target {
-            // An output depends on its inputs and, through the motion, on every state.
             Target::Output(o) => {
-                let mut d = to_fmi(&output_input_deps(model, &model.outputs[o].function));
-                d.extend(&state_index);
-                unknowns.push((k + 1, d));
+                let e = &model.outputs[o].function;
+                let d = structure.output(e);
+                let mut f = inputs_fmi(&d);
+                if global {
+                    let dd = crate::model::expr::deps(e);
+                    let user = !(dd.variables.is_empty() && dd.diffs.is_empty() && dd.diff_dots.is_empty());
+                    if !dd.markers.is_empty() || !dd.loads.is_empty() || user {
+                        f.extend(&state_index);
+                    }
+                } else {
+                    f = to_fmi(&d);
+                }
+                unknowns.push((k + 1, f));
             }
-            // der(S) is the state W itself.
+            // der(S) is the velocity state W itself (Eq. 34g) where it is one; otherwise
+            // ṡ(q, u) depends on the positions and velocities, i.e. on every state.
             Target::StateDerivative(_) => {
-                let d: BTreeSet<usize> = [k + 1].into();
+                let d: BTreeSet<usize> =
+                    if v.known.is_some() { [k + 1].into() } else { to_fmi(&Dependencies::default()) };
                 derivatives.push((k + 1, d.clone()));
                 unknowns.push((k + 1, d));
             }
-            // der(S, 2) = Ẇ and der(X): from the equations of motion, all states and force inputs.
-            Target::StateSecondDerivative(_) | Target::DiffDerivative(_) => {
-                let mut d = state_index.clone();
-                d.extend(to_fmi(&force_inputs(model)));
+            // der(W) = Ẇ: from the equations of motion of its component.
+            Target::VelocityDerivative(i) => {
+                let d = if global { to_fmi(&all_forces) } else { to_fmi(&structure.acceleration(i)) };
                 derivatives.push((k + 1, d.clone()));
                 unknowns.push((k + 1, d));
             }
-            Target::State(_) | Target::Diff(_) => unknowns.push((k + 1, state_index.clone())),
+            // der(X): the user rows read anything (global mode).
+            Target::DiffDerivative(_) => {
+                let d = to_fmi(&all_forces);
+                derivatives.push((k + 1, d.clone()));
+                unknowns.push((k + 1, d));
+            }
+            Target::State(_) | Target::Velocity(_) | Target::Diff(_) => unknowns.push((k + 1, BTreeSet::new())),
             _ => {}
         }
     }
@@ -341,7 +315,11 @@ fn write_structure(x: &mut String, model: &Model, vars: &[Variable]) {
         x.push_str("  <ModelStructure/>\n");
         return;
     }
-    let static_inputs = if model.static_analysis { to_fmi(&force_inputs(model)) } else { BTreeSet::new() };
+    let static_inputs: BTreeSet<usize> = if model.static_analysis {
+        structure.force_inputs().iter().filter_map(|i| input_index.get(*i).copied()).collect()
+    } else {
+        BTreeSet::new()
+    };
     x.push_str("  <ModelStructure>\n");
     let outputs: Vec<&(usize, BTreeSet<usize>)> =
         unknowns.iter().filter(|(i, _)| matches!(vars[i - 1].target, Target::Output(_))).collect();
@@ -412,8 +390,11 @@ mod tests {
     #[test]
     fn dependencies_follow_inputs_through_forces_and_accelerations() {
         let model = crate::model::load_str(INPUTS, "inputs.xml").unwrap_or_else(|e| panic!("{e}"));
-        let d: Vec<Vec<usize>> =
-            model.outputs.iter().map(|o| output_input_deps(&model, &o.function).into_iter().collect()).collect();
+        let d: Vec<Vec<usize>> = model
+            .outputs
+            .iter()
+            .map(|o| Structure::of(&model).output(&o.function).inputs.into_iter().collect())
+            .collect();
         assert_eq!(d, [vec![], vec![2], vec![0, 1], vec![0, 1], vec![0, 2]]);
         let xml = write(&model, INPUTS);
         // Indices: m 1, k 2, u 3, v 4, w 5, pos 6, direct 7, acc 8, reaction 9, force 10.

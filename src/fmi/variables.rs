@@ -1,7 +1,9 @@
 //! The FMI variables of a model and their value references: parameters first, then
-//! inputs, then outputs, then the linearization states S, their velocities `der(S)` (also
-//! states) and accelerations `der(S,2)`, then the differential states X, `der(X)` and the
-//! user variables V, numbered consecutively from 0 in model order. The
+//! inputs, then outputs, then the linearization states: positions S, their derivatives
+//! `der(S)` (the velocity states W where W = Ṡ), velocity states that are not such a
+//! derivative (non-holonomic models: user `<velocity>`s), the velocity derivatives
+//! `der(S,2)` / `der(W)`, then the differential states X, `der(X)` and the user variables
+//! V, numbered consecutively from 0 in model order. The
 //! packer writes them into modelDescription.xml and the C API resolves value references
 //! with them, so both always agree.
 
@@ -26,12 +28,14 @@ pub enum Target {
     Input(usize),
     /// Index into `Model::outputs`.
     Output(usize),
-    /// Linearization state S_k.
+    /// Position state S_k.
     State(usize),
-    /// Its velocity W_k = der(S_k) (a state too).
+    /// der(S_k): the velocity state W_j where W_j = Ṡ_k, otherwise a derivative only.
     StateDerivative(usize),
-    /// Its acceleration der(S_k, 2) = der(W_k).
-    StateSecondDerivative(usize),
+    /// Velocity state W_j that is not the derivative of a position state.
+    Velocity(usize),
+    /// der(W_j) (`der(S_k,2)` where W_j = Ṡ_k).
+    VelocityDerivative(usize),
     /// Differential state X_k (`<differential>`, a state).
     Diff(usize),
     /// Its derivative der(X_k).
@@ -53,6 +57,26 @@ pub struct Variable {
     pub description: Option<String>,
     /// For a state derivative: the 1-based ModelVariables index of its state.
     pub derivative: Option<usize>,
+    /// As a known of the linearization: its column of A and C (S, W, X order).
+    pub known: Option<usize>,
+    /// As an unknown of the linearization: its row of A and B (Ṡ, Ẇ, Ẋ order).
+    pub unknown: Option<usize>,
+}
+
+/// The linearization states an FMU exposes: position states S and velocity states W
+/// (`w_of[j]`: the S index whose derivative W_j is, if any).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct StateLayout {
+    pub s: Vec<String>,
+    pub w: Vec<String>,
+    pub w_of: Vec<Option<usize>>,
+}
+
+impl StateLayout {
+    /// The velocity state that is Ṡ_k, if any.
+    pub fn w_for(&self, k: usize) -> Option<usize> {
+        self.w_of.iter().position(|o| *o == Some(k))
+    }
 }
 
 /// All FMI variables of a model, in ModelVariables order (index + 1 = FMI index).
@@ -68,6 +92,8 @@ pub fn variables(model: &Model) -> Vec<Variable> {
             unit: p.unit.clone(),
             description: p.description.clone(),
             derivative: None,
+            known: None,
+            unknown: None,
         });
     }
     for (k, i) in model.inputs.iter().enumerate() {
@@ -80,6 +106,8 @@ pub fn variables(model: &Model) -> Vec<Variable> {
             unit: i.unit.clone(),
             description: None,
             derivative: None,
+            known: None,
+            unknown: None,
         });
     }
     for (k, o) in model.outputs.iter().enumerate() {
@@ -92,30 +120,62 @@ pub fn variables(model: &Model) -> Vec<Variable> {
             unit: o.unit.clone(),
             description: None,
             derivative: None,
+            known: None,
+            unknown: None,
         });
     }
-    let names = state_names(model);
-    let first = v.len();
-    let s = names.len();
-    for (level, (prefix, suffix)) in [("", ""), ("der(", ")"), ("der(", ",2)")].into_iter().enumerate() {
-        for (k, name) in names.iter().enumerate() {
-            let target = match level {
-                0 => Target::State(k),
-                1 => Target::StateDerivative(k),
-                _ => Target::StateSecondDerivative(k),
-            };
-            v.push(Variable {
-                name: format!("{prefix}{name}{suffix}"),
-                value_reference: v.len() as u32,
-                causality: Causality::Local,
-                target,
-                start: None,
-                unit: None,
-                description: (level == 0).then(|| "linearization state (seed Eq. 33)".to_string()),
-                // 1-based index of the variable this one is the derivative of.
-                derivative: (level > 0).then(|| first + (level - 1) * s + k + 1),
-            });
+    let lay = state_layout(model);
+    let (s0, s1) = (lay.s.len(), lay.w.len());
+    let var = |name: String, vr: usize, target: Target| Variable {
+        name,
+        value_reference: vr as u32,
+        causality: Causality::Local,
+        target,
+        start: None,
+        unit: None,
+        description: None,
+        derivative: None,
+        known: None,
+        unknown: None,
+    };
+    let first_s = v.len();
+    for (k, name) in lay.s.iter().enumerate() {
+        let mut x = var(name.clone(), v.len(), Target::State(k));
+        x.description = Some("linearization state (seed Eq. 33)".into());
+        x.known = Some(k);
+        v.push(x);
+    }
+    let first_sd = v.len();
+    for (k, name) in lay.s.iter().enumerate() {
+        let mut x = var(format!("der({name})"), v.len(), Target::StateDerivative(k));
+        x.derivative = Some(first_s + k + 1);
+        x.known = lay.w_for(k).map(|j| s0 + j);
+        x.unknown = Some(k);
+        v.push(x);
+    }
+    // 1-based index of each W_j's variable.
+    let mut w_index = vec![0; s1];
+    for (j, w) in w_index.iter_mut().enumerate() {
+        if let Some(k) = lay.w_of[j] {
+            *w = first_sd + k + 1;
         }
+    }
+    for j in (0..s1).filter(|&j| lay.w_of[j].is_none()) {
+        let mut x = var(lay.w[j].clone(), v.len(), Target::Velocity(j));
+        x.description = Some("velocity state (non-holonomic model)".into());
+        x.known = Some(s0 + j);
+        w_index[j] = v.len() + 1;
+        v.push(x);
+    }
+    for (j, &wi) in w_index.iter().enumerate() {
+        let name = match lay.w_of[j] {
+            Some(k) => format!("der({},2)", lay.s[k]),
+            None => format!("der({})", lay.w[j]),
+        };
+        let mut x = var(name, v.len(), Target::VelocityDerivative(j));
+        x.derivative = Some(wi);
+        x.unknown = Some(s0 + j);
+        v.push(x);
     }
     let first_x = v.len();
     for (k, d) in model.differentials.iter().enumerate() {
@@ -128,6 +188,8 @@ pub fn variables(model: &Model) -> Vec<Variable> {
             unit: None,
             description: Some("differential state (seed Eq. 7a)".into()),
             derivative: None,
+            known: Some(s0 + s1 + k),
+            unknown: None,
         });
     }
     for (k, d) in model.differentials.iter().enumerate() {
@@ -140,6 +202,8 @@ pub fn variables(model: &Model) -> Vec<Variable> {
             unit: None,
             description: None,
             derivative: Some(first_x + k + 1),
+            known: None,
+            unknown: Some(s0 + s1 + k),
         });
     }
     for (k, d) in model.variables.iter().enumerate() {
@@ -152,15 +216,19 @@ pub fn variables(model: &Model) -> Vec<Variable> {
             unit: None,
             description: Some("user variable (seed Eq. 7b)".into()),
             derivative: None,
+            known: None,
+            unknown: None,
         });
     }
     v
 }
 
-/// Names of the linearization states the FMU exposes (selected from the assembled initial
+/// The linearization states the FMU exposes (selected from the assembled initial
 /// configuration); none when the model cannot be initialized or linearized.
-pub fn state_names(model: &Model) -> Vec<String> {
-    crate::linearize::selection_at_start(model)
-        .map(|sel| sel.states.iter().map(|s| s.name.clone()).collect())
-        .unwrap_or_default()
+pub fn state_layout(model: &Model) -> StateLayout {
+    let Ok(sel) = crate::linearize::selection_at_start(model) else { return StateLayout::default() };
+    let s: Vec<String> = sel.states.iter().map(|x| x.name.clone()).collect();
+    let w: Vec<String> = sel.velocities.iter().map(|x| x.name()).collect();
+    let w_of = w.iter().map(|n| s.iter().position(|sn| format!("der({sn})") == *n)).collect();
+    StateLayout { s, w, w_of }
 }

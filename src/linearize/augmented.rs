@@ -6,6 +6,7 @@
 use super::jets::{PositionFn, jets};
 use super::outputs::output_gradient;
 use super::select::Selection;
+use super::states::VelState;
 use crate::dae::equations::{Layout, jacobian};
 use crate::dae::sparse::{SparseLu, Triplets};
 use crate::dae::{EngineError, Simulator};
@@ -359,20 +360,44 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
     };
     let a = Mat::from_fn(ns, ns, pick);
     let b = Mat::from_fn(ns, ni, |r, c| pick(r, ns + c));
-    // C and D: chain rule through q, u, u̇ and Z sensitivities.
+    // Where W_j = Ṡ_r (always without non-holonomic constraints), the Ṡ rows of A and B are exactly
+    // [0 I 0] and 0 (Eq. 34g–h), without the LU's round-off (the FMU's structural zeros are zeros).
+    let (mut a, mut b) = (a, b);
+    for r in 0..s0 {
+        let w =
+            sel.velocities.iter().position(|w| matches!(w, VelState::Derivative(d) if d.name == sel.states[r].name));
+        if let Some(j) = w {
+            for col in 0..ns {
+                a[(r, col)] = if col == s0 + j { 1.0 } else { 0.0 };
+            }
+            for v in 0..ni {
+                b[(r, v)] = 0.0;
+            }
+        }
+    }
+    // C and D: chain rule through the q, u, u̇, λ (element loads) and Z sensitivities
+    // (solution rows of Eq. 34). Positions and velocities do not depend on the inputs
+    // (Eq. 34d–f, h, j–k hold no input terms), so D takes no q and u terms: they are zero
+    // and would carry only the LU's round-off.
     let no = sys.outputs.len();
     let mut c = Mat::<f64>::zeros(no, ns);
     let mut d = Mat::<f64>::zeros(no, ni);
+    let point = super::outputs::Point { q: &q, u: &u, udot: &udot, lam: &lam, t, inputs };
     for (o, (e, &abase)) in sys.outputs.iter().zip(&sys.output_bases).enumerate() {
-        let g = output_gradient(sys, e, abase, &q, &u, &udot, t, inputs);
+        let g = output_gradient(sys, e, abase, point);
         let nql = NQ * g.bodies.len();
         let sens = |col: usize| -> f64 {
+            let kinematic = col < ns;
             let mut v = 0.0;
             for a in 0..nql {
                 let gi = NQ * g.bodies[a / NQ] + a % NQ;
-                v += g.dz[a] * rhs[(bl.q() + gi, col)]
-                    + g.dz[nql + a] * rhs[(bl.u() + gi, col)]
-                    + g.dz[2 * nql + a] * rhs[(bl.ud() + gi, col)];
+                if kinematic {
+                    v += g.dz[a] * rhs[(bl.q() + gi, col)] + g.dz[nql + a] * rhs[(bl.u() + gi, col)];
+                }
+                v += g.dz[2 * nql + a] * rhs[(bl.ud() + gi, col)];
+            }
+            for &(row, w) in &g.dlam {
+                v += w * rhs[(bl.lam() + row, col)];
             }
             for (zi, &dy) in g.dv[ni..].iter().enumerate() {
                 if dy != 0.0 {
@@ -389,7 +414,7 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
         }
         if (0..ns).any(|col| !c[(o, col)].is_finite()) || (0..ni).any(|v| !d[(o, v)].is_finite()) {
             return Err(EngineError::Numeric(format!(
-                "output '{}' has no finite derivative here (e.g. |v| at v = 0, or element loads, which are not differentiated yet)",
+                "output '{}' has no finite derivative here (e.g. |v| at v = 0, or the load of a user constraint)",
                 sys.output_names[o]
             )));
         }

@@ -17,7 +17,7 @@ use crate::dae::{EngineError, SimOptions, Simulator};
 use crate::mechanics::System;
 use crate::model::Model;
 use jets::jets;
-use states::{internal_state, user_states};
+use states::{VelState, internal_state, user_states};
 
 /// The states an FMU of `model` exposes: selected (Eq. 33) from the assembled initial
 /// configuration with the model's own parameter values and experiment start.
@@ -28,9 +28,10 @@ pub fn selection_at_start(model: &Model) -> Result<Selection, EngineError> {
     select_states(sim.system(), sim.q(), t0, &sim.inputs()).map_err(EngineError::Numeric)
 }
 
-/// Rebuild a selection from state names (user state names, or `body.x|y|z|psi|theta|phi`,
-/// the angles relative to each body's current reference frame).
-pub fn selection_by_name(sys: &System, names: &[String]) -> Result<Selection, String> {
+/// Rebuild a selection from state names: position states (user state names, or
+/// `body.x|y|z|psi|theta|phi`, the angles relative to each body's current reference frame)
+/// and velocity states (`der(<position state>)`, a user `<velocity>`, or `der(body.x)` ...).
+pub fn selection_by_name(sys: &System, names: &[String], w_names: &[String]) -> Result<Selection, String> {
     let users = user_states(sys);
     let coord = ["x", "y", "z", "psi", "theta", "phi"];
     let states = names
@@ -48,21 +49,49 @@ pub fn selection_by_name(sys: &System, names: &[String]) -> Result<Selection, St
             }
         })
         .collect::<Result<Vec<_>, String>>()?;
-    let velocities = select_velocity::derivative_states(&states);
+    let uv = states::user_velocities(sys);
+    let velocities = w_names
+        .iter()
+        .map(|w| {
+            if let Some(v) = uv.iter().find(|v| &v.name == w) {
+                return Ok(VelState::User(v.clone()));
+            }
+            let inner = w.strip_prefix("der(").and_then(|x| x.strip_suffix(')'));
+            let Some(inner) = inner else { return Err(format!("unknown velocity state '{w}'")) };
+            if let Some(s) = states.iter().find(|s| s.name == inner) {
+                return Ok(VelState::Derivative(s.clone()));
+            }
+            selection_by_name(sys, &[inner.to_string()], &[]).map(|sel| VelState::Derivative(sel.states[0].clone()))
+        })
+        .collect::<Result<Vec<_>, String>>()?;
     Ok(Selection { states, velocities, dropped: vec![], rank: sys.redundant.iter().filter(|r| !**r).count() })
 }
 
-/// Values of the states S, their velocities W = Ṡ and accelerations Ẇ at the current point.
-pub fn state_values(sim: &mut Simulator, sel: &Selection) -> Result<[Vec<f64>; 3], EngineError> {
+/// Values at the current point of the position states S, their rates Ṡ, the velocity
+/// states W and their rates Ẇ.
+#[derive(Clone, Debug, Default)]
+pub struct StateValues {
+    pub s: Vec<f64>,
+    pub sd: Vec<f64>,
+    pub w: Vec<f64>,
+    pub wd: Vec<f64>,
+}
+
+/// Values of S, Ṡ, W, Ẇ at the current point.
+pub fn state_values(sim: &mut Simulator, sel: &Selection) -> Result<StateValues, EngineError> {
     let (udot, _) = sim.accelerations()?;
-    let (t, inputs) = (sim.time(), sim.inputs());
+    let (t, ext) = (sim.time(), sim.ext());
     let (q, u) = (sim.q().to_vec(), sim.u().to_vec());
-    let mut v: [Vec<f64>; 3] = Default::default();
+    let mut v = StateValues::default();
     for s in &sel.states {
-        let j = &jets(sim.system(), s, &q, &u, &udot, t, &inputs)[0];
-        v[0].push(j.g);
-        v[1].push(j.g1);
-        v[2].push(j.g2);
+        let j = &jets(sim.system(), s, &q, &u, &udot, t, &ext)[0];
+        v.s.push(j.g);
+        v.sd.push(j.g1);
+    }
+    for w in &sel.velocities {
+        let j = w.jet(sim.system(), &q, &u, &udot, t, &ext);
+        v.w.push(j.w);
+        v.wd.push(j.wd);
     }
     Ok(v)
 }

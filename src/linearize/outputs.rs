@@ -1,73 +1,157 @@
 //! Exact gradients of the `<output>` expressions with respect to q, u, u̇ of the bodies they
-//! read and to the inputs (rows of C and D).
+//! read, to the multipliers λ and to the inputs (rows of C and D).
+//!
+//! An output that reads element loads (`fx(name)` ...) is differentiated in two steps: the
+//! loads are independent seeded variables of the expression (∂y/∂load), chained with each
+//! load's own gradient over q, u, λ and v from [`crate::mechanics::loads`].
 
 use crate::ad::{Dual, Real};
 use crate::mechanics::System;
 use crate::mechanics::body::NQ;
 use crate::mechanics::kernels::gather;
+use crate::mechanics::loads::{NLOAD, load_gradient, load_index, load_value};
 use crate::mechanics::local::LocalCtx;
-use crate::model::expr::{Expr, deps};
+use crate::model::expr::{ElementRef, Expr, LoadFn, deps};
 
-/// Gradient of one output: its bodies, ∂y/∂(q, u, u̇) local (18·nb), and ∂y/∂v per input.
+/// Gradient of one output: its bodies, ∂y/∂(q, u, u̇) local (18·nb: q of every body,
+/// then u, then u̇), ∂y/∂λ as (global row, value) pairs, and ∂y/∂v per input.
 pub struct OutputGradient {
     pub bodies: Vec<usize>,
     pub dz: Vec<f64>,
+    pub dlam: Vec<(usize, f64)>,
     pub dv: Vec<f64>,
 }
 
-/// The gradient of output expression `e` (angle slots from `abase`) at (q, u, u̇, t, v).
-#[allow(clippy::too_many_arguments)]
-pub fn output_gradient(
-    sys: &System,
-    e: &Expr,
-    abase: usize,
-    q: &[f64],
-    u: &[f64],
-    udot: &[f64],
-    t: f64,
-    inputs: &[f64],
-) -> OutputGradient {
-    let mut bodies: Vec<usize> = deps(e).markers.iter().filter_map(|&m| sys.markers[m].body).collect();
-    bodies.sort_unstable();
-    bodies.dedup();
-    let dz = match bodies.len() {
-        0 => grad_k::<1>(sys, e, abase, &bodies, q, u, udot, t, inputs),
-        1 => grad_k::<18>(sys, e, abase, &bodies, q, u, udot, t, inputs),
-        2 => grad_k::<36>(sys, e, abase, &bodies, q, u, udot, t, inputs),
-        3 => grad_k::<54>(sys, e, abase, &bodies, q, u, udot, t, inputs),
-        _ => grad_k::<72>(sys, e, abase, &bodies, q, u, udot, t, inputs),
+/// The operating point: global q, u, u̇, λ, time and input values.
+#[derive(Clone, Copy)]
+pub struct Point<'a> {
+    pub q: &'a [f64],
+    pub u: &'a [f64],
+    pub udot: &'a [f64],
+    pub lam: &'a [f64],
+    pub t: f64,
+    pub inputs: &'a [f64],
+}
+
+/// The gradient of output expression `e` (angle slots from `abase`) at `p`.
+pub fn output_gradient(sys: &System, e: &Expr, abase: usize, p: Point) -> OutputGradient {
+    let d = deps(e);
+    let mut own: Vec<usize> = d.markers.iter().filter_map(|&m| sys.markers[m].body).collect();
+    own.sort_unstable();
+    own.dedup();
+    // Loads read by the expression: values (constants of the passes below) and gradients.
+    let loads: Vec<(ElementRef, [f64; NLOAD])> = d
+        .loads
+        .iter()
+        .map(|&r| (r, load_value(sys, r, (p.q, p.u, p.lam), p.t, p.inputs).unwrap_or([f64::NAN; NLOAD])))
+        .collect();
+    let value_of = |f: LoadFn, r: ElementRef| -> f64 {
+        loads.iter().find(|(x, _)| *x == r).map_or(f64::NAN, |(_, v)| v[load_index(f)])
     };
-    let dv = (0..inputs.len())
+    let dz_own = match own.len() {
+        0 => grad_k::<1>(sys, e, abase, &own, p, &value_of),
+        1 => grad_k::<18>(sys, e, abase, &own, p, &value_of),
+        2 => grad_k::<36>(sys, e, abase, &own, p, &value_of),
+        3 => grad_k::<54>(sys, e, abase, &own, p, &value_of),
+        _ => grad_k::<72>(sys, e, abase, &own, p, &value_of),
+    };
+    let lift = |x: Vec<f64>| -> Vec<Dual<f64, 1>> { x.into_iter().map(Dual::cst).collect() };
+    let mut dv: Vec<f64> = (0..p.inputs.len())
         .map(|k| {
-            let lift = |x: Vec<f64>| -> Vec<Dual<f64, 1>> { x.into_iter().map(Dual::cst).collect() };
-            let (ql, ul, al) = (lift(gather(&bodies, q)), lift(gather(&bodies, u)), lift(gather(&bodies, udot)));
-            let mut ctx = LocalCtx::new(sys, &bodies, &ql, &ul, &al, Dual::cst(t), inputs);
-            ctx.input_values = Some(
-                inputs.iter().enumerate().map(|(i, &v)| if i == k { Dual::var(v, 0) } else { Dual::cst(v) }).collect(),
-            );
+            let (ql, ul, al) = (lift(gather(&own, p.q)), lift(gather(&own, p.u)), lift(gather(&own, p.udot)));
+            let mut ctx = LocalCtx::new(sys, &own, &ql, &ul, &al, Dual::cst(p.t), p.inputs);
+            let seeded = p.inputs.iter().enumerate().map(|(i, &v)| if i == k { Dual::var(v, 0) } else { Dual::cst(v) });
+            ctx.input_values = Some(seeded.collect());
+            let loads = |f: LoadFn, r: ElementRef| Dual::cst(value_of(f, r));
+            ctx.loads = Some(&loads);
             ctx.eval_expr(e, abase).d[0]
         })
         .collect();
-    OutputGradient { bodies, dz, dv }
+    // Bodies of the output and of every load it reads; the output's own gradient first.
+    let mut bodies = own.clone();
+    let grads: Vec<_> = d.loads.iter().map(|&r| (r, load_gradient(sys, r, (p.q, p.u, p.lam), p.t, p.inputs))).collect();
+    for (_, g) in &grads {
+        bodies.extend(g.iter().flat_map(|g| g.bodies.iter().copied()));
+    }
+    bodies.sort_unstable();
+    bodies.dedup();
+    let nql = NQ * bodies.len();
+    let slot = |b: usize| bodies.iter().position(|&x| x == b).expect("listed body");
+    let mut dz = vec![0.0; 3 * nql];
+    let n_own = NQ * own.len();
+    for lvl in 0..3 {
+        for (k, &b) in own.iter().enumerate() {
+            for c in 0..NQ {
+                dz[lvl * nql + NQ * slot(b) + c] += dz_own[lvl * n_own + NQ * k + c];
+            }
+        }
+    }
+    let mut dlam = Vec::new();
+    for (r, g) in grads {
+        // A load without a value (a user constraint's): no derivative either.
+        let Some(g) = g else {
+            dz.fill(f64::NAN);
+            continue;
+        };
+        let dy = load_sensitivity(sys, e, abase, &own, p, &value_of, r);
+        let (nlb, neq, ni) = (NQ * g.bodies.len(), g.neq(), p.inputs.len());
+        for (c, &w) in dy.iter().enumerate().filter(|(_, w)| **w != 0.0) {
+            // Chain rule: dy = Σ_c ∂y/∂load_c (∂load_c/∂q dq + ∂load_c/∂u du + ∂load_c/∂λ dλ + ∂load_c/∂v dv).
+            for a in 0..nlb {
+                let s = NQ * slot(g.bodies[a / NQ]) + a % NQ;
+                dz[s] += w * g.dz[c * 2 * nlb + a];
+                dz[nql + s] += w * g.dz[c * 2 * nlb + nlb + a];
+            }
+            for k in 0..neq {
+                dlam.push((g.lam_row + k, w * g.dlam[c * neq + k]));
+            }
+            for (k, x) in dv.iter_mut().enumerate() {
+                *x += w * g.dv[c * ni + k];
+            }
+        }
+    }
+    OutputGradient { bodies, dz, dlam, dv }
 }
 
-#[allow(clippy::too_many_arguments)]
+/// ∂y/∂(the six components of element `r`'s load), the loads seeded as dual variables.
+fn load_sensitivity(
+    sys: &System,
+    e: &Expr,
+    abase: usize,
+    own: &[usize],
+    p: Point,
+    value_of: &dyn Fn(LoadFn, ElementRef) -> f64,
+    r: ElementRef,
+) -> [f64; NLOAD] {
+    type D = Dual<f64, NLOAD>;
+    let lift = |x: Vec<f64>| -> Vec<D> { x.into_iter().map(D::cst).collect() };
+    let (ql, ul, al) = (lift(gather(own, p.q)), lift(gather(own, p.u)), lift(gather(own, p.udot)));
+    let mut ctx = LocalCtx::new(sys, own, &ql, &ul, &al, D::cst(p.t), p.inputs);
+    let loads = |f: LoadFn, x: ElementRef| {
+        let v = value_of(f, x);
+        if x == r { D::var(v, load_index(f)) } else { D::cst(v) }
+    };
+    ctx.loads = Some(&loads);
+    ctx.eval_expr(e, abase).d
+}
+
+/// ∂y/∂(local q, u, u̇) of the output's own kinematic measures, loads held constant.
 fn grad_k<const K: usize>(
     sys: &System,
     e: &Expr,
     abase: usize,
     bodies: &[usize],
-    q: &[f64],
-    u: &[f64],
-    udot: &[f64],
-    t: f64,
-    inputs: &[f64],
+    p: Point,
+    value_of: &dyn Fn(LoadFn, ElementRef) -> f64,
 ) -> Vec<f64> {
     let nq = NQ * bodies.len();
     let seed = |x: Vec<f64>, off: usize| -> Vec<Dual<f64, K>> {
         x.iter().enumerate().map(|(i, &v)| Dual::var(v, off + i)).collect()
     };
-    let (ql, ul, al) = (seed(gather(bodies, q), 0), seed(gather(bodies, u), nq), seed(gather(bodies, udot), 2 * nq));
-    let ctx = LocalCtx::new(sys, bodies, &ql, &ul, &al, Dual::cst(t), inputs);
+    let (ql, ul, al) =
+        (seed(gather(bodies, p.q), 0), seed(gather(bodies, p.u), nq), seed(gather(bodies, p.udot), 2 * nq));
+    let mut ctx = LocalCtx::new(sys, bodies, &ql, &ul, &al, Dual::cst(p.t), p.inputs);
+    let loads = |f: LoadFn, r: ElementRef| Dual::cst(value_of(f, r));
+    ctx.loads = Some(&loads);
     ctx.eval_expr(e, abase).d[..3 * nq].to_vec()
 }

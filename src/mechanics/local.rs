@@ -36,8 +36,9 @@ pub struct LocalCtx<'a, T: Real> {
     /// External values `ext` = [inputs; user unknowns Z = (X, dX/dt, V)] (see
     /// [`System::ext`]); a shorter slice (inputs only) reads user unknowns as NaN.
     pub inputs: &'a [f64],
-    /// Element loads for `fx(...)` (outputs only); `None` reads as NaN.
-    pub loads: Option<&'a dyn Fn(LoadFn, ElementRef) -> f64>,
+    /// Element loads for `fx(...)` (outputs only), as scalars of this context (constants,
+    /// or dual numbers seeded on the loads themselves); `None` reads as NaN.
+    pub loads: Option<&'a dyn Fn(LoadFn, ElementRef) -> T>,
     /// First global angle slot of the expression being evaluated.
     angle_base: Cell<usize>,
     /// When set, every unwrapped angle is recorded as (global slot, value).
@@ -151,7 +152,7 @@ impl<T: Real> ExprEnv<T> for LocalCtx<'_, T> {
         }
     }
     fn load(&self, f: LoadFn, e: ElementRef) -> T {
-        T::cst(self.loads.map_or(f64::NAN, |l| l(f, e)))
+        self.loads.map_or(T::cst(f64::NAN), |l| l(f, e))
     }
     /// Angles stay on the branch nearest their value at the last accepted step.
     fn unwrap_angle(&self, slot: usize, a: T) -> T {

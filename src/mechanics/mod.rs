@@ -4,9 +4,11 @@
 //! from [`crate::ad::Dual`] numbers through the kernels in [`kernels`].
 
 pub mod body;
+pub mod components;
 pub mod constraints;
 pub mod forces;
 pub mod kernels;
+pub mod loads;
 pub mod local;
 pub mod nonholonomic;
 pub mod system;
