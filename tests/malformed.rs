@@ -334,3 +334,9 @@ case!(
     "56_spring_angle_on_translational.xml",
     "56_spring_angle_on_translational.xml:4:93: spring_damper 'k': attribute 'angle' is not allowed on a translational spring_damper (use 'length')"
 );
+
+case!(
+    m57_state_name_clash,
+    "57_state_name_clash.xml",
+    "57_state_name_clash.xml:5:12: state 'height': name 'height' is already an FMI variable (line 3)"
+);

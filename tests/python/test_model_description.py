@@ -61,8 +61,8 @@ def test_packed_fmu_validates(model: Path, tmp_path: Path):
         assert z.read("resources/model.xml") == model.read_bytes()
 
     # The variables are the model's parameters, inputs and outputs, in file order, then the
-    # linearization states S, their velocities der(S) and accelerations der(S,2); value
-    # references 0, 1, 2, ...
+    # linearization states S, their velocities der(S) and accelerations der(S,2) (in general
+    # der(W)), then X, der(X), V; value references 0, 1, 2, ...
     root = ET.parse(model).getroot()
     expected = [(e.get("name"), c) for tag, c in (("parameter", "parameter"), ("input", "input"), ("output", "output"))
                 for e in root.iter(tag)]
@@ -70,10 +70,20 @@ def test_packed_fmu_validates(model: Path, tmp_path: Path):
     assert actual[: len(expected)] == expected
     local = [name for name, c in actual[len(expected):]]
     assert all(c == "local" for _, c in actual[len(expected):])
-    s = len(local) // 3
-    assert len(local) == 3 * s
-    assert local[s:2 * s] == [f"der({n})" for n in local[:s]]
-    assert local[2 * s:] == [f"der({n},2)" for n in local[:s]]
+    # ... then differential states X, der(X) and user variables V last.
+    diffs = [e.get("name") for e in root.iter("differential")]
+    tail = diffs + [f"der({d})" for d in diffs] + [e.get("name") for e in root.iter("variable")]
+    assert local[len(local) - len(tail):] == tail
+    lin = local[: len(local) - len(tail)]
+    # Linearization states: S, der(S), velocity states that are no der(S) (non-holonomic
+    # models), then der(W) (named der(S,2) where W = der(S)).
+    descr = {v.name: v.description for v in md.modelVariables}
+    s = sum(1 for n in lin if descr[n] == "linearization state (seed Eq. 33)")
+    assert lin[s:2 * s] == [f"der({n})" for n in lin[:s]]
+    extra = [n for n in lin[2 * s:] if descr[n] == "velocity state (non-holonomic model)"]
+    assert lin[2 * s:2 * s + len(extra)] == extra
+    if not root.findall("rolling_wheel") + root.findall("knife_edge") + root.findall("velocity_constraint"):
+        assert extra == [] and lin[2 * s:] == [f"der({n},2)" for n in lin[:s]]
     assert [v.valueReference for v in md.modelVariables] == list(range(len(actual)))
     assert md.defaultExperiment is not None
 

@@ -284,6 +284,16 @@ impl<'a> Loader<'a> {
             let el = self.el(c);
             let function = el.expr_req("function")?;
             let (name, pos) = (c.label().to_string(), c.pos);
+            // Linearization states become FMI variables: their names must not clash with
+            // the other FMI variables (parameters, inputs, outputs, differentials, variables).
+            let clash = match self.scope.names.get(&name) {
+                Some(&(_, line)) => Some(line),
+                None => self.ns_outputs.line(&name),
+            };
+            if let Some(line) = clash {
+                let at = el.get("name").map_or(c.pos, |a| a.pos);
+                return Err(el.err_at(at, format!("name '{name}' is already an FMI variable (line {line})")));
+            }
             if c.tag == "state" {
                 check_deps(&el, "function", &function, Allowed::Positions)?;
                 self.model.lin_states.push(LinState { name, function, pos });

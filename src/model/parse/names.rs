@@ -41,6 +41,10 @@ impl Namespace {
     pub fn get(&self, name: &str) -> Option<usize> {
         self.seen.get(name).map(|&(i, _)| i)
     }
+    /// Line of a declared name.
+    pub fn line(&self, name: &str) -> Option<usize> {
+        self.seen.get(name).map(|&(_, l)| l)
+    }
 }
 
 /// Everything a name in the model can refer to; implements the expression [`Scope`].
