@@ -53,7 +53,9 @@ const KITCHEN_SINK: &str = r#"<multibody name="sink" version="1">
   <variable name="loop2" function="-0.2*loop1^2 + sin(xi) + wz(c.cm)"/>
   <differential name="xi" start="0.2" function="loop1 - 0.5*xi + vx(b.cm)"/>
   <differential name="filt" start="-0.1" implicit="true" function="0.3*dif1(filt) + filt^3 - loop2*dif1(xi)"/>
-  <sforce name="fu" type="translational" i="a.cm" j="c.cm" function="2*loop1 + filt*v - xi"/>
+  <variable name="fric" function="0.2*sqrt(fz(jrev)^2 + 0.01) + 0.1*fx(st) - 0.05*ty(jsph)"/>
+  <sforce name="fu" type="translational" i="a.cm" j="c.cm" function="2*loop1 + filt*v - xi + fric"/>
+  <gforce name="g4" i="c.cm" force="0.3*fy(jrev) 0 tz(mrot)" torque="0 0 0.1*fx(g2)"/>
   <gforce name="g3" i="b.cm" force="loop2 dif1(filt) 0" torque="0 0 xi*wz(b.cm)"/>
 </multibody>"#;
 
@@ -70,7 +72,8 @@ fn setup() -> (System, Layout, Vec<f64>) {
     let model = load_str(KITCHEN_SINK, "sink.xml").unwrap_or_else(|e| panic!("{e}"));
     let sys = System::from_model(&model).unwrap();
     let lay = Layout::of(&sys);
-    assert_eq!((lay.nx, lay.nv), (2, 2));
+    assert_eq!((lay.nx, lay.nv), (2, 3));
+    assert_eq!(sys.load_refs.len(), 5);
     let mut seed = 7;
     let mut y = vec![0.0; lay.dim()];
     for i in 0..lay.n {
@@ -179,7 +182,7 @@ fn nonholonomic_acceleration_right_hand_side_is_the_time_derivative_of_g() {
     assert_eq!(sys.mn, 6);
     let t = 0.43;
     let (q, u) = (&y[..lay.n], &y[lay.u()..lay.u() + lay.n]);
-    let ext = lay.ext(&INPUTS, &y);
+    let ext = lay.ext(&sys, &INPUTS, &y, t);
     let mut seed = 5;
     let a: Vec<f64> = (0..lay.n).map(|_| rng(&mut seed)).collect();
     let qd: Vec<f64> = (0..sys.nb()).flat_map(|b| qdot(&q[NQ * b..NQ * b + NQ], &u[NQ * b..NQ * b + NQ])).collect();

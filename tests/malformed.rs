@@ -174,13 +174,13 @@ case!(
 case!(
     m27_sforce_uses_acceleration,
     "27_sforce_uses_acceleration.xml",
-    "27_sforce_uses_acceleration.xml:4:60: sforce 's': forces depending on accelerations or loads are not supported yet"
+    "27_sforce_uses_acceleration.xml:4:60: sforce 's': forces and user elements depending on accelerations are not supported yet"
 );
 
 case!(
-    m28_gforce_uses_load,
-    "28_gforce_uses_load.xml",
-    "28_gforce_uses_load.xml:5:26: gforce 'g': forces depending on accelerations or loads are not supported yet"
+    m28_gforce_load_unknown_element,
+    "28_gforce_load_unknown_element.xml",
+    "28_gforce_load_unknown_element.xml:5:39: gforce 'g': bad expression in 'force': unknown element 'jj'"
 );
 
 case!(

@@ -14,6 +14,7 @@ use crate::mechanics::kernels::{
     constraint_first, constraint_second, dhtw_dq, dqdot_dq, force_ext_jacobian, force_jacobian, force_values, gather,
     gyroscopic, nonholonomic_second, user_jacobian, user_residual,
 };
+use crate::mechanics::loads::{LoadGradient, NLOAD, load_gradient};
 
 /// Index layout of y.
 #[derive(Clone, Copy, Debug)]
@@ -61,11 +62,11 @@ impl Layout {
     pub fn mu(&self) -> usize {
         2 * self.n + self.nz() + self.m + self.mn
     }
-    /// The external values [inputs; Z] of state `y`.
-    pub fn ext(&self, inputs: &[f64], y: &[f64]) -> Vec<f64> {
-        let mut e = inputs.to_vec();
-        e.extend_from_slice(&y[self.z()..self.z() + self.nz()]);
-        e
+    /// The external values [inputs; Z; L] of state `y` at time `t` (see [`System::ext`]).
+    pub fn ext(&self, sys: &System, inputs: &[f64], y: &[f64], t: f64) -> Vec<f64> {
+        let n = self.n;
+        let state = (&y[..n], &y[n..2 * n], &y[self.lam()..self.lam() + self.m]);
+        sys.ext(inputs, &y[self.z()..self.z() + self.nz()], Some(state), t)
     }
 }
 
@@ -107,7 +108,7 @@ pub fn p_row(bodies: &[usize], q: &[f64], cq: &[f64]) -> Vec<f64> {
 pub fn rhs(sys: &System, lay: Layout, t: f64, y: &[f64], inputs: &[f64], f: &mut [f64]) {
     let (n, nu, nl, nm) = (lay.n, lay.u(), lay.lam(), lay.mu());
     let (q, u) = (&y[..n], &y[nu..nu + n]);
-    let ext = lay.ext(inputs, y);
+    let ext = lay.ext(sys, inputs, y, t);
     let inputs = &ext[..];
     let nz = lay.z();
     for i in 0..lay.nx {
@@ -163,9 +164,10 @@ pub fn rhs(sys: &System, lay: Layout, t: f64, y: &[f64], inputs: &[f64], f: &mut
 pub fn jacobian(sys: &System, lay: Layout, t: f64, y: &[f64], inputs: &[f64], jac: &mut Triplets) {
     let (n, nu, nl, nm) = (lay.n, lay.u(), lay.lam(), lay.mu());
     let (q, u) = (&y[..n], &y[nu..nu + n]);
-    let ext = lay.ext(inputs, y);
+    let ext = lay.ext(sys, inputs, y, t);
     let inputs = &ext[..];
     let (nz, ni) = (lay.z(), sys.ni());
+    let lc = LoadChain::new(sys, lay, y, t, &ext);
     for i in 0..lay.nx {
         jac.push(nz + i, nz + lay.nx + i, 1.0);
     }
@@ -179,7 +181,9 @@ pub fn jacobian(sys: &System, lay: Layout, t: f64, y: &[f64], inputs: &[f64], ja
             jac.push(row, nu + g, uj.dqu[nql + a]);
         }
         for (e, v) in uj.dext {
-            if e >= ni {
+            if e >= ni + lay.nz() {
+                lc.push(jac, row, e, v);
+            } else if e >= ni {
                 jac.push(row, nz + e - ni, v);
             }
         }
@@ -252,8 +256,10 @@ pub fn jacobian(sys: &System, lay: Layout, t: f64, y: &[f64], inputs: &[f64], ja
             }
         }
         for (e, col) in force_ext_jacobian(sys, el, q, u, t, inputs) {
-            if e >= ni {
-                for (r, v) in col.iter().enumerate() {
+            for (r, v) in col.iter().enumerate() {
+                if e >= ni + lay.nz() {
+                    lc.push(jac, nu + glob(&el.bodies, r), e, *v);
+                } else if e >= ni {
                     jac.push(nu + glob(&el.bodies, r), nz + e - ni, *v);
                 }
             }
@@ -423,4 +429,47 @@ pub fn nonholonomic_b(sys: &System, q: &[f64], u: &[f64], t: f64, ext: &[f64]) -
         }
     }
     (b, g)
+}
+
+/// The chain rule through element loads read as external values (`System::load_refs`):
+/// ∂r/∂L · ∂L/∂(q, u, λ, Z), with each load's exact gradient from [`crate::mechanics::loads`].
+struct LoadChain {
+    lay: Layout,
+    ni: usize,
+    base_len: usize,
+    grads: Vec<Option<LoadGradient>>,
+}
+
+impl LoadChain {
+    fn new(sys: &System, lay: Layout, y: &[f64], t: f64, ext: &[f64]) -> LoadChain {
+        let (n, ni) = (lay.n, sys.ni());
+        let base = &ext[..ni + lay.nz()];
+        let state = (&y[..n], &y[n..2 * n], &y[lay.lam()..lay.lam() + lay.m]);
+        let grads = sys.load_refs.iter().map(|&r| load_gradient(sys, r, state, t, base)).collect();
+        LoadChain { lay, ni, base_len: base.len(), grads }
+    }
+
+    /// Add coeff · ∂L_e/∂(unknowns) to row `row` (e: external-value index of a load).
+    fn push(&self, jac: &mut Triplets, row: usize, e: usize, coeff: f64) {
+        let lay = self.lay;
+        let k = e - self.ni - lay.nz();
+        let (slot, c) = (k / NLOAD, k % NLOAD);
+        let Some(g) = &self.grads[slot] else { return };
+        let nlb = NQ * g.bodies.len();
+        for a in 0..nlb {
+            let gl = glob(&g.bodies, a);
+            jac.push(row, gl, coeff * g.dz[c * 2 * nlb + a]);
+            jac.push(row, lay.u() + gl, coeff * g.dz[c * 2 * nlb + nlb + a]);
+        }
+        let neq = g.neq();
+        for kk in 0..neq {
+            jac.push(row, lay.lam() + g.lam_row + kk, coeff * g.dlam[c * neq + kk]);
+        }
+        for z in 0..lay.nz() {
+            let d = g.dv.get(c * self.base_len + self.ni + z).copied().unwrap_or(0.0);
+            if d != 0.0 {
+                jac.push(row, lay.z() + z, coeff * d);
+            }
+        }
+    }
 }

@@ -301,7 +301,7 @@ pub fn static_equilibrium(
     let mut lu = SparseLu::new();
     // Start from the multipliers at rest: the stiffness of a mechanism under gravity is in
     // the reactions' geometric term (Pᵀλ)_q, absent at λ = 0.
-    let ext = lay.ext(inputs, &y);
+    let ext = lay.ext(sys, inputs, &y, t);
     let (_, lam0) = accelerations(sys, q, &vec![0.0; n], t, &ext, &mut lu)?;
     y[nl..nl + m].copy_from_slice(&lam0[..m]);
     // Equations: u rows, user rows, C rows; unknowns: q, X, V, λ (Ẋ = 0 held).
@@ -349,23 +349,33 @@ pub fn static_equilibrium(
     Err("static equilibrium: Newton did not converge in 100 iterations".into())
 }
 
-/// The algebraic user unknowns (Ẋ, V) from the user rows (Eq. 7a–7b) at given q, u, X:
-/// Newton with the exact Jacobian; `z` = (X, Ẋ, V) in and out (X is kept).
-pub fn user_unknowns(sys: &System, q: &[f64], u: &[f64], t: f64, inputs: &[f64], z: &mut [f64]) -> Result<(), String> {
+/// The algebraic user unknowns (Ẋ, V) from the user rows (Eq. 7a–7b) at given q, u, X
+/// (and multipliers λ, for rows that read element loads): Newton with the exact Jacobian;
+/// `z` = (X, Ẋ, V) in and out (X is kept).
+#[allow(clippy::too_many_arguments)]
+pub fn user_unknowns(
+    sys: &System,
+    q: &[f64],
+    u: &[f64],
+    lam: Option<&[f64]>,
+    t: f64,
+    inputs: &[f64],
+    z: &mut [f64],
+) -> Result<(), String> {
     use crate::mechanics::kernels::user_jacobian;
     let (nx, ni, k) = (sys.nx, sys.ni(), sys.user.len());
     if k == 0 {
         return Ok(());
     }
     for _ in 0..50 {
-        let ext = sys.ext(inputs, z);
+        let ext = sys.ext(inputs, z, lam.map(|l| (q, u, l)), t);
         let mut jac = faer::Mat::<f64>::zeros(k, k);
         let mut r = faer::Mat::<f64>::zeros(k, 1);
         for (row, ue) in sys.user.iter().enumerate() {
             let uj = user_jacobian(sys, ue, q, u, t, &ext);
             r[(row, 0)] = -uj.value;
             for (e, v) in uj.dext {
-                if e >= ni + nx {
+                if e >= ni + nx && e < ni + sys.nz() {
                     jac[(row, e - ni - nx)] += v;
                 }
             }
@@ -383,4 +393,37 @@ pub fn user_unknowns(sys: &System, q: &[f64], u: &[f64], t: f64, inputs: &[f64],
         }
     }
     Err("user variables/differentials: Newton did not converge at the initial state (algebraic loop?)".into())
+}
+
+/// User unknowns, accelerations and multipliers at the initial point. When forces or user
+/// rows read element loads (an algebraic loop through the constraint forces), the loads
+/// depend on λ and λ on the forces: fixed-point iteration on λ (the integrator then solves
+/// the loop simultaneously, by Newton with the exact Jacobian).
+#[allow(clippy::too_many_arguments)]
+pub fn consistent_accelerations(
+    sys: &System,
+    q: &[f64],
+    u: &[f64],
+    t: f64,
+    inputs: &[f64],
+    z: &mut [f64],
+    lu: &mut SparseLu,
+) -> Result<(Vec<f64>, Vec<f64>), String> {
+    let mut lam: Option<Vec<f64>> = None;
+    for _ in 0..200 {
+        user_unknowns(sys, q, u, lam.as_deref(), t, inputs, z)?;
+        let ext = sys.ext(inputs, z, lam.as_deref().map(|l| (q, u, l)), t);
+        let (udot, new) = accelerations(sys, q, u, t, &ext, lu)?;
+        if sys.load_refs.is_empty() {
+            return Ok((udot, new));
+        }
+        let scale = 1.0 + new.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let change =
+            lam.as_ref().map_or(f64::INFINITY, |l| l.iter().zip(&new).fold(0.0f64, |a, (x, y)| a.max((x - y).abs())));
+        if change <= 1e-13 * scale {
+            return Ok((udot, new));
+        }
+        lam = Some(new);
+    }
+    Err("the algebraic loop through element loads does not converge at the initial state".into())
 }

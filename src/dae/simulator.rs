@@ -185,7 +185,7 @@ impl DaeProblem for MultibodyDae {
             }
         }
         let n = self.lay.n;
-        let ext = self.lay.ext(&self.inputs_at(t), y);
+        let ext = self.lay.ext(&self.sys, &self.inputs_at(t), y, t);
         self.record_angles(t, &y[..n], &y[n..2 * n], &ext);
         let inputs = ext;
         for k in 0..self.sys.forces.len() {
@@ -274,14 +274,13 @@ impl Simulator {
         z[..lay.nx].copy_from_slice(&sys.x_init);
         if model.static_analysis {
             u.iter_mut().for_each(|v| *v = 0.0);
-            init::user_unknowns(&sys, &q, &u, t0, &inputs, &mut z).map_err(EngineError::Numeric)?;
+            init::user_unknowns(&sys, &q, &u, None, t0, &inputs, &mut z).map_err(EngineError::Numeric)?;
             init::static_equilibrium(&sys, &mut q, &mut z, t0, &inputs, assembly_tol).map_err(EngineError::Numeric)?;
         }
         init::assemble_velocities(&sys, &q, &mut u, t0, &inputs).map_err(EngineError::Numeric)?;
-        init::user_unknowns(&sys, &q, &u, t0, &inputs, &mut z).map_err(EngineError::Numeric)?;
         let mut acc_lu = SparseLu::new();
-        let ext = sys.ext(&inputs, &z);
-        let (udot, lam) = init::accelerations(&sys, &q, &u, t0, &ext, &mut acc_lu).map_err(EngineError::Numeric)?;
+        let (udot, lam) = init::consistent_accelerations(&sys, &q, &u, t0, &inputs, &mut z, &mut acc_lu)
+            .map_err(EngineError::Numeric)?;
         let mut y = vec![0.0; lay.dim()];
         y[..lay.n].copy_from_slice(&q);
         y[lay.u()..lay.u() + lay.n].copy_from_slice(&u);
@@ -339,12 +338,18 @@ impl Simulator {
     pub fn accelerations(&mut self) -> Result<(Vec<f64>, Vec<f64>), EngineError> {
         if self.acc.is_none() {
             let (q, u) = (self.q().to_vec(), self.u().to_vec());
-            let ext = self.ext();
             let s = &self.dae;
-            self.acc = Some(
-                init::accelerations(&s.sys, &q, &u, self.radau.t, &ext, &mut self.acc_lu)
-                    .map_err(EngineError::Numeric)?,
-            );
+            let t = self.radau.t;
+            self.acc = Some(if s.sys.load_refs.is_empty() {
+                let ext = self.ext();
+                init::accelerations(&s.sys, &q, &u, t, &ext, &mut self.acc_lu).map_err(EngineError::Numeric)?
+            } else {
+                // Loads in the loop: λ (and the loads) solved together, as at initialization.
+                let mut z = self.user_values().to_vec();
+                let inputs = s.inputs_at(t);
+                init::consistent_accelerations(&s.sys, &q, &u, t, &inputs, &mut z, &mut self.acc_lu)
+                    .map_err(EngineError::Numeric)?
+            });
         }
         Ok(self.acc.clone().expect("just computed"))
     }
@@ -360,7 +365,7 @@ impl Simulator {
         let sys = &self.dae.sys;
         let ids: Vec<usize> = (0..sys.nb()).collect();
         let ctx_loads = |f: LoadFn, e: ElementRef| self.load_component(f, e, &lam);
-        let inputs = self.ext();
+        let inputs = self.ext_with(&lam);
         let mut ctx = LocalCtx::new(sys, &ids, self.q(), self.u(), &udot, self.radau.t, &inputs);
         ctx.loads = Some(&ctx_loads);
         Ok(sys.outputs.iter().zip(&sys.output_bases).map(|(e, &b)| ctx.eval_expr(e, b)).collect())
@@ -370,7 +375,8 @@ impl Simulator {
     /// from [`crate::mechanics::loads`].
     fn load_component(&self, f: LoadFn, e: ElementRef, lam: &[f64]) -> f64 {
         let t = self.radau.t;
-        load_value(&self.dae.sys, e, (self.q(), self.u(), lam), t, &self.ext()).map_or(f64::NAN, |l| l[load_index(f)])
+        load_value(&self.dae.sys, e, (self.q(), self.u(), lam), t, &self.ext_with(lam))
+            .map_or(f64::NAN, |l| l[load_index(f)])
     }
 
     /// Largest |g_i(q, u, t)| over the non-holonomic constraints at the current time.
@@ -537,7 +543,16 @@ impl Simulator {
 
     /// The external values [inputs; Z] at the current time (see [`System::ext`]).
     pub fn ext(&self) -> Vec<f64> {
-        self.dae.lay.ext(&self.dae.inputs_at(self.radau.t), &self.radau.y)
+        self.dae.lay.ext(&self.dae.sys, &self.dae.inputs_at(self.radau.t), &self.radau.y, self.radau.t)
+    }
+
+    /// The external values with the element loads evaluated at multipliers `lam` (those of
+    /// [`Simulator::accelerations`], so outputs and linearization see one consistent λ).
+    pub fn ext_with(&self, lam: &[f64]) -> Vec<f64> {
+        let (n, m, t) = (self.dae.lay.n, self.dae.sys.m, self.radau.t);
+        let y = &self.radau.y;
+        let state = (&y[..n], &y[n..2 * n], &lam[..m]);
+        self.dae.sys.ext(&self.dae.inputs_at(t), self.user_values(), Some(state), t)
     }
 
     /// Current user unknowns Z = (X, Ẋ, V).

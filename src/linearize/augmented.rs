@@ -12,6 +12,7 @@ use crate::dae::sparse::{SparseLu, Triplets};
 use crate::dae::{EngineError, Simulator};
 use crate::mechanics::body::NQ;
 use crate::mechanics::kernels::{force_ext_jacobian, user_jacobian};
+use crate::mechanics::loads::{LoadGradient, NLOAD, load_gradient};
 use faer::Mat;
 
 /// A, B, C, D at one operating point, with the names of states, inputs and outputs.
@@ -171,7 +172,7 @@ fn check_partition(
 pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result<Linearization, EngineError> {
     let (udot, lam) = sim.accelerations()?;
     let t = sim.time();
-    let ext = sim.ext();
+    let ext = sim.ext_with(&lam);
     let inputs = &ext[..];
     let (q, u) = (sim.q().to_vec(), sim.u().to_vec());
     let sys = sim.system();
@@ -201,7 +202,7 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
     let mut y = vec![0.0; lay.dim()];
     y[..n].copy_from_slice(&q);
     y[n..2 * n].copy_from_slice(&u);
-    y[lay.z()..lay.z() + nz].copy_from_slice(&ext[ni..]);
+    y[lay.z()..lay.z() + nz].copy_from_slice(&ext[ni..ni + nz]);
     y[lay.lam()..lay.lam() + m + mn].copy_from_slice(&lam);
     let mut jac = Triplets::new();
     jacobian(sys, lay, t, &y, &inputs[..ni], &mut jac);
@@ -383,6 +384,10 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
     let mut c = Mat::<f64>::zeros(no, ns);
     let mut d = Mat::<f64>::zeros(no, ni);
     let point = super::outputs::Point { q: &q, u: &u, udot: &udot, lam: &lam, t, inputs };
+    // Loads that forces and user rows read (external values): their exact gradients, for
+    // outputs that depend on them indirectly (e.g. the load of a force that reads a load).
+    let lgrads: Vec<Option<LoadGradient>> =
+        sys.load_refs.iter().map(|&r| load_gradient(sys, r, (&q, &u, &lam[..m]), t, &ext[..ni + nz])).collect();
     for (o, (e, &abase)) in sys.outputs.iter().zip(&sys.output_bases).enumerate() {
         let g = output_gradient(sys, e, abase, point);
         let nql = NQ * g.bodies.len();
@@ -399,9 +404,27 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
             for &(row, w) in &g.dlam {
                 v += w * rhs[(bl.lam() + row, col)];
             }
-            for (zi, &dy) in g.dv[ni..].iter().enumerate() {
+            for (zi, &dy) in g.dv[ni..ni + nz].iter().enumerate() {
                 if dy != 0.0 {
                     v += dy * rhs[(bl.z() + zi, col)];
+                }
+            }
+            for (li, &dy) in g.dv[ni + nz..].iter().enumerate() {
+                let Some(lg) = lgrads[li / NLOAD].as_ref().filter(|_| dy != 0.0) else { continue };
+                let (c, nlb, neq) = (li % NLOAD, NQ * lg.bodies.len(), lg.neq());
+                for a in 0..nlb {
+                    let gi = NQ * lg.bodies[a / NQ] + a % NQ;
+                    if kinematic {
+                        v += dy * lg.dz[c * 2 * nlb + a] * rhs[(bl.q() + gi, col)];
+                        v += dy * lg.dz[c * 2 * nlb + nlb + a] * rhs[(bl.u() + gi, col)];
+                    }
+                }
+                for k in 0..neq {
+                    v += dy * lg.dlam[c * neq + k] * rhs[(bl.lam() + lg.lam_row + k, col)];
+                }
+                for zi in 0..nz {
+                    let d = lg.dv.get(c * (ni + nz) + ni + zi).copied().unwrap_or(0.0);
+                    v += dy * d * rhs[(bl.z() + zi, col)];
                 }
             }
             v

@@ -152,7 +152,14 @@ impl<T: Real> ExprEnv<T> for LocalCtx<'_, T> {
         }
     }
     fn load(&self, f: LoadFn, e: ElementRef) -> T {
-        self.loads.map_or(T::cst(f64::NAN), |l| l(f, e))
+        match self.loads {
+            Some(l) => l(f, e),
+            // Forces and user rows read loads as external values (see `System::load_refs`).
+            None => match self.sys.ext_load_of(e, super::loads::load_index(f)) {
+                Some(k) => self.ext_value(k),
+                None => T::cst(f64::NAN),
+            },
+        }
     }
     /// Angles stay on the branch nearest their value at the last accepted step.
     fn unwrap_angle(&self, slot: usize, a: T) -> T {

@@ -60,6 +60,10 @@ pub struct System {
     pub mn: usize,
     /// User rows (differentials, then variables; seed Eq. 7a–7b).
     pub user: Vec<UserEq>,
+    /// Elements whose loads (`fx(name)` ...) forces and user rows read: their six load
+    /// components are external values, evaluated from (q, u, λ) (algebraic loops through
+    /// constraint forces are solved with the equations of motion).
+    pub load_refs: Vec<ElementRef>,
     /// Number of differential states X and of variables V.
     pub nx: usize,
     pub nv: usize,
@@ -274,8 +278,40 @@ impl System {
         }
         let m = constraints.iter().map(|c| c.neq).sum();
 
-        let (ni, nx) = (model.inputs.len(), model.differentials.len());
-        let refs = |es: &[&Expr]| ext_refs(ni, nx, es);
+        let (ni, nx, nv) = (model.inputs.len(), model.differentials.len(), model.variables.len());
+        let mut load_refs: Vec<ElementRef> = Vec::new();
+        {
+            let mut es: Vec<&Expr> = model.sforces.iter().map(|s| &s.function).collect();
+            es.extend(model.gforces.iter().flat_map(|g| g.force.iter().chain(g.torque.iter())));
+            es.extend(model.variables.iter().map(|v| &v.function));
+            es.extend(model.differentials.iter().map(|d| &d.function));
+            for e in es {
+                load_refs.extend(deps(e).loads);
+            }
+            load_refs.sort_unstable_by_key(|r| format!("{r:?}"));
+            load_refs.dedup();
+        }
+        for r in &load_refs {
+            let reads_loads = |es: Vec<&Expr>| es.iter().any(|e| !deps(e).loads.is_empty());
+            let bad = match *r {
+                ElementRef::Constraint(k) => {
+                    Some(format!("user constraint '{}' has no load", model.constraints[k].name))
+                }
+                ElementRef::Sforce(k) if reads_loads(vec![&model.sforces[k].function]) => {
+                    Some(format!("sforce '{}' reads loads itself", model.sforces[k].name))
+                }
+                ElementRef::Gforce(k)
+                    if reads_loads(model.gforces[k].force.iter().chain(&model.gforces[k].torque).collect()) =>
+                {
+                    Some(format!("gforce '{}' reads loads itself", model.gforces[k].name))
+                }
+                _ => None,
+            };
+            if let Some(msg) = bad {
+                return Err(format!("a force or user element reads a load that cannot be used there: {msg}"));
+            }
+        }
+        let refs = |es: &[&Expr]| ext_refs(ni, nx, nv, &load_refs, es);
         let mut forces = Vec::new();
         for s in &model.spring_dampers {
             let kind = ForceKind::SpringDamper {
@@ -400,6 +436,7 @@ impl System {
             nonholonomic,
             mn,
             user,
+            load_refs,
             nx,
             nv: model.variables.len(),
             x_init: model.differentials.iter().map(|d| d.start.value).collect(),

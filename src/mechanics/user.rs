@@ -3,10 +3,11 @@
 //! implicit (f(Ẋ, X, …) = 0) differentials and variables (V = g) are all algebraic rows
 //! r(q, u, Z, v, t) = 0, and X' = Ẋ is the differential part.
 
+use super::loads::NLOAD;
 use super::local::LocalCtx;
 use super::system::System;
 use crate::ad::Real;
-use crate::model::expr::{Expr, deps};
+use crate::model::expr::{ElementRef, Expr, deps};
 
 /// What a user row is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -47,15 +48,22 @@ impl UserEq {
     }
 }
 
-/// Entries of the external values (inputs, X, Ẋ, V) that the expressions `es` read.
-pub fn ext_refs(sys_ni: usize, nx: usize, es: &[&Expr]) -> Vec<usize> {
+/// Entries of the external values (inputs, X, Ẋ, V, element loads L) that the
+/// expressions `es` read; `load_refs` lists the elements whose loads are external values.
+pub fn ext_refs(sys_ni: usize, nx: usize, nv: usize, load_refs: &[ElementRef], es: &[&Expr]) -> Vec<usize> {
     let mut r = Vec::new();
+    let l0 = sys_ni + 2 * nx + nv;
     for e in es {
         let d = deps(e);
         r.extend(d.inputs.iter().copied());
         r.extend(d.diffs.iter().map(|&i| sys_ni + i));
         r.extend(d.diff_dots.iter().map(|&i| sys_ni + nx + i));
         r.extend(d.variables.iter().map(|&i| sys_ni + 2 * nx + i));
+        for l in &d.loads {
+            if let Some(k) = load_refs.iter().position(|x| x == l) {
+                r.extend((0..NLOAD).map(|c| l0 + NLOAD * k + c));
+            }
+        }
     }
     r.sort_unstable();
     r.dedup();
@@ -83,11 +91,26 @@ impl System {
     pub fn ext_variable(&self, i: usize) -> usize {
         self.ni() + 2 * self.nx + i
     }
-    /// The external values [inputs; Z] that element contexts read.
-    pub fn ext(&self, inputs: &[f64], z: &[f64]) -> Vec<f64> {
-        let mut e = Vec::with_capacity(inputs.len() + z.len());
+    /// External-value index of the first load component of `load_refs[k]`.
+    pub fn ext_load(&self, k: usize) -> usize {
+        self.ni() + self.nz() + NLOAD * k
+    }
+    /// External-value index of element `e`'s load component `c`, if forces or user
+    /// elements read that element's loads.
+    pub fn ext_load_of(&self, e: ElementRef, c: usize) -> Option<usize> {
+        self.load_refs.iter().position(|x| *x == e).map(|k| self.ext_load(k) + c)
+    }
+    /// The external values [inputs; Z; L] that element contexts read; the loads L are
+    /// evaluated at `state` = (q, u, λ) (see [`super::loads`]); without λ (None) they are 0.
+    pub fn ext(&self, inputs: &[f64], z: &[f64], state: Option<(&[f64], &[f64], &[f64])>, t: f64) -> Vec<f64> {
+        let mut e = Vec::with_capacity(inputs.len() + z.len() + NLOAD * self.load_refs.len());
         e.extend_from_slice(inputs);
         e.extend_from_slice(z);
+        let base = e.clone();
+        for &r in &self.load_refs {
+            let v = state.and_then(|s| super::loads::load_value(self, r, s, t, &base)).unwrap_or([0.0; NLOAD]);
+            e.extend_from_slice(&v);
+        }
         e
     }
 }

@@ -3,7 +3,7 @@
 #![allow(dead_code)]
 
 use faer::linalg::solvers::Solve;
-use mbfmu::dae::init::accelerations;
+use mbfmu::dae::init::consistent_accelerations;
 use mbfmu::dae::sparse::SparseLu;
 use mbfmu::linearize::Selection;
 use mbfmu::linearize::jets::{PositionFn, jets};
@@ -15,7 +15,9 @@ use mbfmu::model::expr::{ElementRef, LoadFn};
 
 /// The engine's state-space map x = (S, W), v ↦ (Ṡ, Ẇ, y) at time t: q from C(q) = 0,
 /// s(q) = S by Newton (from `q0`); u from P u + C_t = 0, ṡ(q, u) = W; u̇ and λ from the
-/// equations of motion; the outputs y from (q, u, u̇) and the element loads from (q, u, λ).
+/// equations of motion (an algebraic loop through element loads solved by fixed point);
+/// the outputs y from (q, u, u̇) and the element loads from (q, u, λ). Models without
+/// differential states only (user variables are solved, not states).
 /// Central differences of this map are the tests' independent reference for A, B, C, D.
 pub fn state_space(sys: &System, sel: &Selection, q0: &[f64], t: f64, x: &[f64], v: &[f64]) -> (Vec<f64>, Vec<f64>) {
     let (n, m, s) = (sys.n(), sys.m, sel.states.len());
@@ -67,15 +69,18 @@ pub fn state_space(sys: &System, sel: &Selection, q0: &[f64], t: f64, x: &[f64],
     // ṡ and Ċ are affine in u: residual at u = 0, matrix = their u-gradients.
     let (mat, r) = square(&q, &zeros, 1);
     let u: Vec<f64> = solve(&mat, &r).iter().map(|x| -x).collect();
-    let (udot, lam) = accelerations(sys, &q, &u, t, v, &mut SparseLu::new()).unwrap();
+    // Accelerations and multipliers (with any algebraic loop through element loads solved).
+    let mut z = vec![0.0; sys.nz()];
+    let (udot, lam) = consistent_accelerations(sys, &q, &u, t, v, &mut z, &mut SparseLu::new()).unwrap();
     let mut xd = x[s..].to_vec();
     for st in &sel.states {
         xd.push(jets(sys, st, &q, &u, &udot, t, v)[0].g2);
     }
     let ids: Vec<usize> = (0..sys.nb()).collect();
+    let ext = sys.ext(v, &z, Some((&q, &u, &lam)), t);
     let loads =
-        |f: LoadFn, e: ElementRef| load_value(sys, e, (&q, &u, &lam), t, v).map_or(f64::NAN, |l| l[load_index(f)]);
-    let mut ctx = LocalCtx::new(sys, &ids, &q, &u, &udot, t, v);
+        |f: LoadFn, e: ElementRef| load_value(sys, e, (&q, &u, &lam), t, &ext).map_or(f64::NAN, |l| l[load_index(f)]);
+    let mut ctx = LocalCtx::new(sys, &ids, &q, &u, &udot, t, &ext);
     ctx.loads = Some(&loads);
     let y = sys.outputs.iter().zip(&sys.output_bases).map(|(e, &b)| ctx.eval_expr(e, b)).collect();
     (xd, y)

@@ -41,7 +41,7 @@ pub(crate) enum Allowed {
     Positions,
     /// Positions, velocities, time, parameters (linearization velocities).
     Velocities,
-    /// Forces: anything but accelerations and element loads.
+    /// Forces, variables, differentials: anything but accelerations.
     Force,
     /// Outputs: anything.
     Any,
@@ -52,8 +52,8 @@ pub(crate) fn check_deps(el: &El, attr: &str, e: &Expr, allowed: Allowed) -> Res
     let d = expr::deps(e);
     let at = el.get(attr).map_or(el.x.pos, |a| a.pos);
     if allowed == Allowed::Force {
-        if d.level >= 2 || !d.loads.is_empty() {
-            return Err(el.err_at(at, "forces depending on accelerations or loads are not supported yet"));
+        if d.level >= 2 {
+            return Err(el.err_at(at, "forces and user elements depending on accelerations are not supported yet"));
         }
         return Ok(());
     }
