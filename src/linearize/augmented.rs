@@ -7,6 +7,7 @@ use super::jets::{PositionFn, jets};
 use super::outputs::output_gradient;
 use super::select::Selection;
 use crate::dae::equations::{Layout, jacobian};
+use crate::dae::rank::full_pivot;
 use crate::dae::sparse::{SparseLu, Triplets};
 use crate::dae::{EngineError, Simulator};
 use crate::mechanics::body::NQ;
@@ -95,7 +96,7 @@ impl Blocks {
 const PARTITION_TOL: f64 = 1e-8;
 
 /// Check that the states still parameterize the motion here (the determinant condition
-/// after Eq. 36): full-pivot LU of the square [C_q; s_q].
+/// after Eq. 36): sparse complete-pivoting elimination of the square [C_q; s_q].
 fn check_partition(
     sys: &crate::mechanics::System,
     sel: &Selection,
@@ -105,7 +106,7 @@ fn check_partition(
 ) -> Result<(), EngineError> {
     let n = sys.n();
     let zeros = vec![0.0; n];
-    let mut j = Mat::<f64>::zeros(n, n);
+    let mut j: Vec<(usize, usize, f64)> = Vec::new();
     let mut row = 0;
     for el in &sys.constraints {
         for (e, jet) in jets(sys, el, q, &zeros, &zeros, t, inputs).iter().enumerate() {
@@ -114,7 +115,7 @@ fn check_partition(
             }
             for (a, &b) in el.bodies.iter().enumerate() {
                 for c in 0..NQ {
-                    j[(row, NQ * b + c)] = jet.dg[NQ * a + c];
+                    j.push((row, NQ * b + c, jet.dg[NQ * a + c]));
                 }
             }
             row += 1;
@@ -127,22 +128,26 @@ fn check_partition(
         }
         for (a, &b) in st.bodies().iter().enumerate() {
             for c in 0..NQ {
-                j[(row, NQ * b + c)] = jet.dg[NQ * a + c];
+                j.push((row, NQ * b + c, jet.dg[NQ * a + c]));
             }
         }
         row += 1;
     }
-    let lu = j.full_piv_lu();
-    let u = lu.U();
-    let piv: Vec<f64> = (0..n).map(|i| u[(i, i)].abs()).collect();
-    let big = piv.iter().copied().fold(0.0, f64::max);
-    let small = piv.iter().copied().fold(f64::INFINITY, f64::min);
-    if small.is_nan() || small <= PARTITION_TOL * big {
+    // Stops at the first pivot ≤ PARTITION_TOL·largest: then the next candidate is the ratio.
+    let ratio = match full_pivot(n, n, j, PARTITION_TOL, 0.0) {
+        Ok(p) if p.rank == n => {
+            let small = p.magnitudes.iter().copied().fold(f64::INFINITY, f64::min);
+            small / p.largest()
+        }
+        Ok(p) => p.remaining / p.largest().max(p.remaining),
+        Err(_) => f64::NAN,
+    };
+    if ratio.is_nan() || ratio <= PARTITION_TOL {
         return Err(EngineError::Numeric(format!(
             "at t = {t}: the linearization states ({}) no longer parameterize the motion (singular partition, \
              pivot ratio {:.1e}); choose user states (<linearization>) that stay independent",
             sel.states.iter().map(|s| s.name.as_str()).collect::<Vec<_>>().join(", "),
-            small / big
+            ratio
         )));
     }
     Ok(())
