@@ -1,10 +1,14 @@
 //! Sparse rank-revealing Gaussian elimination with complete (full) pivoting: each step
-//! takes the largest |entry| left anywhere in the matrix (a max-heap with lazy
-//! invalidation), eliminates its column from the other rows holding it, and stops when
-//! the largest entry left is negligible. Rows are sorted sparse vectors, so the cost is
-//! that of the fill, not of the dense size. The arithmetic per entry is that of a dense
-//! full-pivoting LU (multiplier a_ic·(1/p), update by one fused multiply-add), so without
-//! ties in |entry| it makes the same choices; ties go to the smallest column, then row.
+//! takes the largest |entry| left anywhere in the matrix (a max-heap of each row's
+//! largest entry, lazily invalidated), eliminates its column from the other rows holding
+//! it, and stops when the largest entry left is negligible. Rows are sorted sparse
+//! vectors, so time and memory follow the fill, not the dense size. The arithmetic per
+//! entry is that of a dense full-pivoting LU (multiplier a_ic·(1/p), update by one fused
+//! multiply-add), so without ties in |entry| it makes the same choices; ties go to the
+//! smallest column, then row. The fill is that of the dense U: none for the benchmark
+//! chain's C_q at its start (bodies unrotated), but a triangle over the last ~s columns
+//! once positions depend on all the states before them (the chain in motion: ~s²/2
+//! entries, O(s³) updates).
 
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
@@ -43,8 +47,8 @@ impl Pivots {
     }
 }
 
-/// A heap candidate: |value| (as ordered bits), then the smaller column and row first;
-/// valid while its row still has `version`.
+/// A heap candidate: a row's largest |entry| (as ordered bits), the smaller column and
+/// row first on ties; valid while its row still has `version`.
 #[derive(Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 struct Candidate {
     abs_bits: u64,
@@ -62,29 +66,39 @@ struct Work {
     row_done: Vec<bool>,
     col_done: Vec<bool>,
     version: Vec<u32>,
+    /// One candidate per row (its largest entry): every row holding a pivot column is
+    /// updated in that step, so an unchanged row's largest entry stays valid.
     heap: BinaryHeap<Candidate>,
+    active_rows: usize,
     nnz: usize,
 }
 
 impl Work {
-    /// Put every entry of row `i` on the heap under a new version.
-    fn push_row(&mut self, i: usize) {
+    /// Put row `i`'s largest entry, |value| `best` at index `at`, on the heap under a new
+    /// version (nothing for an empty row).
+    fn candidate(&mut self, i: usize, best: f64, at: usize) {
         self.version[i] = self.version[i].wrapping_add(1);
-        let v = self.version[i];
-        for &(c, x) in &self.rows[i] {
-            self.heap.push(Candidate {
-                abs_bits: x.abs().to_bits(),
-                col: Reverse(c),
-                row: Reverse(i as u32),
-                version: v,
-            });
+        if let Some(&(col, _)) = self.rows[i].get(at) {
+            let (abs_bits, version) = (best.to_bits(), self.version[i]);
+            self.heap.push(Candidate { abs_bits, col: Reverse(col), row: Reverse(i as u32), version });
         }
     }
 
-    /// Largest valid candidate, dropping stale ones; rebuilds the heap when stale
-    /// entries dominate (keeps memory O(nnz)).
+    /// Put row `i`'s largest entry (the first, i.e. smallest column, on ties) on the heap.
+    fn push_row(&mut self, i: usize) {
+        let (mut best, mut at) = (-1.0, 0);
+        for (k, e) in self.rows[i].iter().enumerate() {
+            if e.1.abs() > best {
+                (best, at) = (e.1.abs(), k);
+            }
+        }
+        self.candidate(i, best, at);
+    }
+
+    /// The largest valid candidate, dropping stale ones; the heap is rebuilt when stale
+    /// entries dominate (memory O(rows)).
     fn top(&mut self) -> Option<Candidate> {
-        if self.heap.len() > 4 * self.nnz + 1024 {
+        if self.heap.len() > 2 * self.active_rows + 1024 {
             self.heap.clear();
             for i in 0..self.rows.len() {
                 if !self.row_done[i] {
@@ -104,72 +118,83 @@ impl Work {
 
     /// Eliminate column `c` with pivot row `r` from every other active row holding it.
     fn eliminate(&mut self, r: usize, c: u32) {
-        let pivot_row: Vec<(u32, f64)> = std::mem::take(&mut self.rows[r]);
-        self.nnz -= pivot_row.len();
-        let p = pivot_row.iter().find(|e| e.0 == c).map(|e| e.1).expect("pivot in its row");
-        let inv = p.recip();
-        let rest: Vec<(u32, f64)> = pivot_row.into_iter().filter(|e| e.0 != c).collect();
+        let mut rest: Vec<(u32, f64)> = std::mem::take(&mut self.rows[r]);
+        self.nnz -= rest.len();
+        let at = rest.binary_search_by_key(&c, |e| e.0).expect("pivot in its row");
+        let inv = rest.remove(at).1.recip();
         self.row_done[r] = true;
+        self.active_rows -= 1;
         self.col_done[c as usize] = true;
         let holders = std::mem::take(&mut self.col_rows[c as usize]);
+        let mut out = Vec::new();
         for &i in &holders {
             let i = i as usize;
             if self.row_done[i] {
                 continue;
             }
             let Ok(k) = self.rows[i].binary_search_by_key(&c, |e| e.0) else { continue };
-            let l = self.rows[i][k].1 * inv;
-            let old = std::mem::take(&mut self.rows[i]);
-            let before = old.len();
-            let merged = merge_update(&old, k, l, &rest, |j| self.col_rows[j as usize].push(i as u32));
-            self.nnz = self.nnz + merged.len() - before;
-            self.rows[i] = merged;
-            self.push_row(i);
+            let l = self.rows[i].remove(k).1 * inv;
+            out.clear();
+            let (best, at) =
+                merge_update(&self.rows[i], l, &rest, &mut out, |j| self.col_rows[j as usize].push(i as u32));
+            self.nnz = self.nnz + out.len() - self.rows[i].len() - 1;
+            std::mem::swap(&mut self.rows[i], &mut out);
+            self.candidate(i, best, at);
         }
     }
 }
 
-/// row_i − l·rest with row_i's entry `skip` (the pivot column) removed; each update is
-/// one fused multiply-add as in a dense LU; exact zeros are dropped; `gained` is told
-/// each column new to the row (fill).
+/// out = row − l·rest (both sorted by column); each update is one fused multiply-add as
+/// in a dense LU; exact zeros are dropped; `gained` is told each column new to the row.
+/// Returns out's largest |entry| and its index (the first, smallest column, on ties).
 fn merge_update(
     row: &[(u32, f64)],
-    skip: usize,
     l: f64,
     rest: &[(u32, f64)],
+    out: &mut Vec<(u32, f64)>,
     mut gained: impl FnMut(u32),
-) -> Vec<(u32, f64)> {
-    let mut out = Vec::with_capacity(row.len() + rest.len());
-    let (mut a, mut b) = (0, 0);
-    let put = |out: &mut Vec<(u32, f64)>, c: u32, v: f64| {
-        if v != 0.0 {
-            out.push((c, v));
+) -> (f64, usize) {
+    out.reserve(row.len() + rest.len());
+    let (mut best, mut at) = (-1.0, 0);
+    let mut put = |out: &mut Vec<(u32, f64)>, c: u32, v: f64| {
+        if v.abs() > best {
+            (best, at) = (v.abs(), out.len());
         }
+        out.push((c, v));
     };
-    while a < row.len() || b < rest.len() {
-        if a == skip {
-            a += 1;
-            continue;
-        }
-        let ca = row.get(a).map_or(u32::MAX, |e| e.0);
-        let cb = rest.get(b).map_or(u32::MAX, |e| e.0);
-        if ca < cb {
-            put(&mut out, ca, row[a].1);
-            a += 1;
-        } else if cb < ca {
-            let v = l.mul_add(-rest[b].1, 0.0);
+    let (mut a, mut b) = (0, 0);
+    while a < row.len() && b < rest.len() {
+        let ((ca, va), (cb, vb)) = (row[a], rest[b]);
+        if ca == cb {
+            let v = l.mul_add(-vb, va);
             if v != 0.0 {
+                put(out, ca, v);
+            }
+            a += 1;
+            b += 1;
+        } else if ca < cb {
+            put(out, ca, va);
+            a += 1;
+        } else {
+            let v = -(l * vb); // = fma(l, −vb, 0)
+            if v != 0.0 {
+                put(out, cb, v);
                 gained(cb);
             }
-            put(&mut out, cb, v);
-            b += 1;
-        } else {
-            put(&mut out, ca, l.mul_add(-rest[b].1, row[a].1));
-            a += 1;
             b += 1;
         }
     }
-    out
+    for &(ca, va) in &row[a..] {
+        put(out, ca, va);
+    }
+    for &(cb, vb) in &rest[b..] {
+        let v = -(l * vb);
+        if v != 0.0 {
+            put(out, cb, v);
+            gained(cb);
+        }
+    }
+    (best, at)
 }
 
 /// Gaussian elimination with complete pivoting of the `nrows`×`ncols` matrix given as
@@ -215,7 +240,8 @@ pub fn full_pivot(
         row_done: vec![false; nrows],
         col_done: vec![false; ncols],
         version: vec![0; nrows],
-        heap: BinaryHeap::with_capacity(2 * nnz),
+        heap: BinaryHeap::with_capacity(nrows),
+        active_rows: nrows,
         nnz,
     };
     for i in 0..nrows {
