@@ -1,10 +1,11 @@
 //! The augmented sensitivity system (seed Eq. 34a–34k, Table 1): unknowns
 //! (u̇, q̇, Ẇ, Ṡ, λ, u, q, W, S) differentiated with respect to the virtual states (S̄, W̄)
-//! and the inputs v. One sparse matrix, one sparse LU, all right-hand sides at once
-//! (split over threads). Nothing is reduced to the state-space ODE (Eq. 6).
+//! and the inputs v. One sparse matrix, one sparse LU, the right-hand sides in blocks
+//! (split over threads), keeping only the rows A, B, C, D need. Nothing is reduced to
+//! the state-space ODE (Eq. 6).
 
 use super::jets::{PositionFn, jets};
-use super::outputs::output_gradient;
+use super::outputs::{OutputGradient, output_gradient};
 use super::select::Selection;
 use crate::dae::equations::{Layout, jacobian};
 use crate::dae::rank::full_pivot;
@@ -97,7 +98,7 @@ const PARTITION_TOL: f64 = 1e-8;
 
 /// Check that the states still parameterize the motion here (the determinant condition
 /// after Eq. 36): sparse complete-pivoting elimination of the square [C_q; s_q].
-fn check_partition(
+pub fn check_partition(
     sys: &crate::mechanics::System,
     sel: &Selection,
     q: &[f64],
@@ -262,21 +263,50 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
         k.push(bl.row('j') + i, bl.w() + i, 1.0);
         k.push(bl.row('k') + i, bl.sv() + i, 1.0);
     }
-    // Right-hand sides: ∂/∂S̄ (34k), ∂/∂W̄ (34j), ∂/∂v (34a: +∂Q/∂v).
+    // Right-hand sides: ∂/∂S̄ (34k), ∂/∂W̄ (34j), ∂/∂v (34a: +∂Q/∂v), the last sparse.
     let ni = inputs.len();
-    let dim = bl.dim();
-    let mut rhs = Mat::<f64>::zeros(dim, 2 * s + ni);
-    for i in 0..s {
-        rhs[(bl.row('k') + i, i)] = 1.0;
-        rhs[(bl.row('j') + i, s + i)] = 1.0;
-    }
+    let mut dq_dv: Vec<Vec<(usize, f64)>> = vec![Vec::new(); ni];
     for el in &sys.forces {
         for (v, col) in force_input_jacobian(sys, el, &q, &u, t, &inputs).iter().enumerate() {
             for (a, &val) in col.iter().enumerate() {
-                rhs[(bl.row('a') + NQ * el.bodies[a / NQ] + a % NQ, 2 * s + v)] += val;
+                dq_dv[v].push((bl.row('a') + NQ * el.bodies[a / NQ] + a % NQ, val));
             }
         }
     }
+    let fill = |col: usize, b: &mut [f64]| {
+        if col < s {
+            b[bl.row('k') + col] = 1.0;
+        } else if col < 2 * s {
+            b[bl.row('j') + col - s] = 1.0;
+        } else {
+            for &(r, v) in &dq_dv[col - 2 * s] {
+                b[r] += v;
+            }
+        }
+    };
+    // Kept of each solution: Ṡ, Ẇ (a column of A or B) and the outputs' sensitivities
+    // through q, u, u̇ (chain rule; a column of C or D without ∂y/∂v).
+    let grads: Vec<OutputGradient> = sys
+        .outputs
+        .iter()
+        .zip(&sys.output_bases)
+        .map(|(e, &abase)| output_gradient(sys, e, abase, &q, &u, &udot, t, &inputs))
+        .collect();
+    let take = |_: usize, x: &[f64]| -> Vec<f64> {
+        let mut keep = Vec::with_capacity(2 * s + grads.len());
+        keep.extend_from_slice(&x[bl.sd()..bl.sd() + s]);
+        keep.extend_from_slice(&x[bl.wd()..bl.wd() + s]);
+        for g in &grads {
+            let nql = NQ * g.bodies.len();
+            let mut v = 0.0;
+            for a in 0..nql {
+                let gi = NQ * g.bodies[a / NQ] + a % NQ;
+                v += g.dz[a] * x[bl.q() + gi] + g.dz[nql + a] * x[bl.u() + gi] + g.dz[2 * nql + a] * x[bl.ud() + gi];
+            }
+            keep.push(v);
+        }
+        keep
+    };
     let mut lu = SparseLu::new();
     let singular = || {
         EngineError::Numeric(format!(
@@ -285,37 +315,14 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
             sel.states.iter().map(|s| s.name.as_str()).collect::<Vec<_>>().join(", ")
         ))
     };
-    lu.factor(dim, &k).map_err(|_| singular())?;
-    if !lu.solve_parallel(rhs.as_mut(), threads) {
-        return Err(singular());
-    }
-    // A and B: rows Ṡ, Ẇ of the solution.
-    let pick = |r: usize, c: usize| if r < s { rhs[(bl.sd() + r, c)] } else { rhs[(bl.wd() + r - s, c)] };
-    let a = Mat::from_fn(2 * s, 2 * s, pick);
-    let b = Mat::from_fn(2 * s, ni, |r, c| pick(r, 2 * s + c));
-    // C and D: chain rule through q, u, u̇ sensitivities.
-    let no = sys.outputs.len();
-    let mut c = Mat::<f64>::zeros(no, 2 * s);
-    let mut d = Mat::<f64>::zeros(no, ni);
-    for (o, (e, &abase)) in sys.outputs.iter().zip(&sys.output_bases).enumerate() {
-        let g = output_gradient(sys, e, abase, &q, &u, &udot, t, &inputs);
-        let nql = NQ * g.bodies.len();
-        let sens = |col: usize| -> f64 {
-            let mut v = 0.0;
-            for a in 0..nql {
-                let gi = NQ * g.bodies[a / NQ] + a % NQ;
-                v += g.dz[a] * rhs[(bl.q() + gi, col)]
-                    + g.dz[nql + a] * rhs[(bl.u() + gi, col)]
-                    + g.dz[2 * nql + a] * rhs[(bl.ud() + gi, col)];
-            }
-            v
-        };
-        for col in 0..2 * s {
-            c[(o, col)] = sens(col);
-        }
-        for v in 0..ni {
-            d[(o, v)] = sens(2 * s + v) + g.dv[v];
-        }
+    lu.factor(bl.dim(), &k).map_err(|_| singular())?;
+    let sol = lu.solve_columns(2 * s + ni, threads, fill, take).ok_or_else(singular)?;
+    let a = Mat::from_fn(2 * s, 2 * s, |r, c| sol[c][r]);
+    let b = Mat::from_fn(2 * s, ni, |r, v| sol[2 * s + v][r]);
+    let no = grads.len();
+    let c = Mat::from_fn(no, 2 * s, |o, col| sol[col][2 * s + o]);
+    let d = Mat::from_fn(no, ni, |o, v| sol[2 * s + v][2 * s + o] + grads[o].dv[v]);
+    for o in 0..no {
         if (0..2 * s).any(|col| !c[(o, col)].is_finite()) || (0..ni).any(|v| !d[(o, v)].is_finite()) {
             return Err(EngineError::Numeric(format!(
                 "output '{}' has no finite derivative here (e.g. |v| at v = 0, or element loads, which are not differentiated yet)",
