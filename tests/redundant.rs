@@ -61,3 +61,40 @@ fn all_revolute_fourbar_moves_and_linearizes_like_the_non_redundant_one() {
         }
     }
 }
+
+#[test]
+fn redundancy_is_found_in_a_large_model() {
+    // 150 copies of the all-revolute four-bar on the same ground pivots: n = 2700
+    // coordinates, m = 3000 equations (n·m = 8.1e6, beyond the former dense limit of 4e6).
+    // Each copy has 3 redundant equations, so 450 are found, 150 states are selected, and
+    // the linearization exists.
+    let (_, revolutes) = fourbars();
+    let k = 150;
+    let (b0, b1) = (revolutes.find("<body").unwrap(), revolutes.rfind("</body>").unwrap() + "</body>".len());
+    let joints: Vec<&str> = revolutes.lines().filter(|l| l.trim_start().starts_with("<joint")).collect();
+    let mut copies = String::new();
+    for c in 0..k {
+        let mut part = revolutes[b0..b1].to_string();
+        part.extend(joints.iter().map(|l| format!("\n{l}")));
+        for body in ["crank", "coupler", "rocker"] {
+            part = part.replace(&format!("name=\"{body}\""), &format!("name=\"{body}{c}\""));
+            part = part.replace(&format!("=\"{body}."), &format!("=\"{body}{c}."));
+        }
+        for joint in ["crank_pivot", "crank_pin", "rocker_pin", "rocker_pivot"] {
+            part = part.replace(&format!("name=\"{joint}\""), &format!("name=\"{joint}{c}\""));
+        }
+        copies.push_str(&part);
+        copies.push('\n');
+    }
+    let xml = format!("{}{}</multibody>\n", &revolutes[..b0], copies);
+    let m = load_str(&xml, "many.xml").unwrap();
+    assert_eq!(m.summary().constraints, 20 * k);
+    let mut sim = Simulator::new(&m, SimOptions::default(), 0.0).unwrap();
+    assert_eq!(sim.system().n() * sim.system().m, 2700 * 3000);
+    assert_eq!(sim.system().redundant.iter().filter(|r| **r).count(), 3 * k);
+    let sel = select_states(sim.system(), sim.q(), 0.0, &sim.inputs()).unwrap();
+    assert_eq!(sel.states.len(), k);
+    assert_eq!(sel.rank, 17 * k);
+    let lin = linearize(&mut sim, &sel, 2).unwrap();
+    assert_eq!(lin.a.nrows(), 2 * k);
+}

@@ -4,6 +4,7 @@
 //! multipliers from [M Pᵀ; P 0][u̇; λ] = [Q; −γ] (Eq. 1c–1d).
 
 use super::equations::{acceleration_rhs, applied_forces, nonholonomic_b, nonholonomic_gamma, p_row};
+use super::rank::full_pivot;
 use super::sparse::{SparseLu, Triplets};
 use crate::mechanics::System;
 use crate::mechanics::body::NQ;
@@ -148,36 +149,29 @@ fn push_p_blocks(sys: &System, q: &[f64], t: f64, inputs: &[f64], n: usize, kkt:
 
 /// Relative pivot size below which a constraint row counts as redundant.
 pub const REDUNDANCY_TOL: f64 = 1e-6;
-/// Largest n·m for the dense rank-revealing factorization (beyond it: assume independent).
-const REDUNDANCY_DENSE_LIMIT: usize = 4_000_000;
 
-/// Constraint rows that depend on others at (q, t): full-pivot LU of C_qᵀ; the rows that
-/// get no pivot are redundant (e.g. a planar loop of revolutes modelled in 3-D).
+/// Constraint rows that depend on others at (q, t): sparse complete-pivoting elimination
+/// of C_qᵀ; the rows that get no pivot are redundant (e.g. a planar loop of revolutes
+/// modelled in 3-D). A non-finite C_q counts as independent (assembly reports it).
 pub fn redundant_rows(sys: &System, q: &[f64], t: f64, inputs: &[f64]) -> Vec<bool> {
     let (n, m) = (sys.n(), sys.m);
-    let mut red = vec![false; m];
-    if m == 0 || n * m > REDUNDANCY_DENSE_LIMIT {
-        return red;
+    if m == 0 {
+        return Vec::new();
     }
-    let mut ct = faer::Mat::<f64>::zeros(n, m);
+    let mut ct = Vec::new();
     for el in &sys.constraints {
         let f = constraint_first(sys, el, q, t, inputs);
         let nql = NQ * el.bodies.len();
         for e in 0..el.neq {
             for a in 0..nql {
-                ct[(NQ * el.bodies[a / NQ] + a % NQ, el.row + e)] += f.cq[e * nql + a];
+                ct.push((NQ * el.bodies[a / NQ] + a % NQ, el.row + e, f.cq[e * nql + a]));
             }
         }
     }
-    let lu = ct.full_piv_lu();
-    let u = lu.U();
-    let k = n.min(m);
-    let big = (0..k).map(|i| u[(i, i)].abs()).fold(0.0, f64::max);
-    let rank = (0..k).take_while(|&i| u[(i, i)].abs() > REDUNDANCY_TOL * big).count();
-    for &c in &lu.Q().arrays().0[rank..] {
-        red[c] = true;
+    match full_pivot(n, m, ct, REDUNDANCY_TOL, 0.0) {
+        Ok(p) => p.pivoted_cols(m).iter().map(|&pivoted| !pivoted).collect(),
+        Err(_) => vec![false; m],
     }
-    red
 }
 
 /// Consistent velocities: u closest to `u` with P u + C_t = 0 and exact velocity ICs.

@@ -5,6 +5,7 @@ pub mod equations;
 pub mod init;
 pub mod radau;
 mod radau_tableau;
+pub mod rank;
 mod simulator;
 pub mod sparse;
 

@@ -2,6 +2,7 @@
 //! unchanged: the pattern is compared entry by entry, numeric values are re-factored.
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::linalg::lu::{LuRef, LuSymbolicParams, NumericLu, SymbolicLu, factorize_symbolic_lu};
 use faer::sparse::{Argsort, Pair, SparseColMat, SymbolicSparseColMat};
@@ -37,6 +38,9 @@ impl Triplets {
         }
     }
 }
+
+/// Right-hand sides solved at once by [`SparseLu::solve_columns`].
+const SOLVE_BLOCK: usize = 16;
 
 struct Symbolic {
     n: usize,
@@ -121,36 +125,70 @@ impl SparseLu {
         self.solve_mat(b.as_mut())
     }
 
-    /// Solve A X = B in place for the columns of `b`, splitting them over `threads`
-    /// threads (each with its own scratch); the factorization is shared read-only.
-    pub fn solve_parallel(&self, b: MatMut<'_, f64>, threads: usize) -> bool {
-        let (Some(s), Some(numeric)) = (&self.symbolic, &self.numeric) else { return false };
-        let solve = |mut part: MatMut<'_, f64>| -> bool {
-            let mut buf = MemBuffer::new(s.lu.solve_in_place_scratch::<f64>(part.ncols(), Par::Seq));
-            LuRef::new_unchecked(&s.lu, numeric).solve_in_place_with_conj(
-                Conj::No,
-                part.as_mut(),
-                Par::Seq,
-                MemStack::new(&mut buf),
-            );
-            (0..part.ncols()).all(|j| (0..part.nrows()).all(|i| part[(i, j)].is_finite()))
-        };
-        let k = b.ncols();
-        let threads = threads.clamp(1, k.max(1));
-        if threads == 1 {
-            return solve(b);
-        }
-        let chunk = k.div_ceil(threads);
-        std::thread::scope(|sc| {
-            let mut rest = b;
-            let mut handles = Vec::new();
-            while rest.ncols() > 0 {
-                let take = chunk.min(rest.ncols());
-                let (head, tail) = rest.split_at_col_mut(take);
-                rest = tail;
-                handles.push(sc.spawn(move || solve(head)));
+    /// Solve A x = b for `ncols` right-hand sides without holding them all: `fill(j, b)`
+    /// writes column j into a zeroed b, `take(j, x)` keeps what is needed of its
+    /// solution. Columns go in blocks of `SOLVE_BLOCK` over `threads` threads (each
+    /// with its own block and scratch; the factorization is shared read-only), so the
+    /// memory is threads·dim·SOLVE_BLOCK. None if a solution is not finite (singular).
+    pub fn solve_columns<T: Send>(
+        &self,
+        ncols: usize,
+        threads: usize,
+        fill: impl Fn(usize, &mut [f64]) + Sync,
+        take: impl Fn(usize, &[f64]) -> T + Sync,
+    ) -> Option<Vec<T>> {
+        let (Some(s), Some(numeric)) = (&self.symbolic, &self.numeric) else { return None };
+        let dim = s.n;
+        let solve_range = |cols: std::ops::Range<usize>| -> Option<Vec<T>> {
+            let mut out = Vec::with_capacity(cols.len());
+            let width = SOLVE_BLOCK.min(cols.len());
+            let mut block = Mat::<f64>::zeros(dim, width);
+            let mut buf = MemBuffer::new(s.lu.solve_in_place_scratch::<f64>(width, Par::Seq));
+            for start in cols.clone().step_by(SOLVE_BLOCK) {
+                let w = SOLVE_BLOCK.min(cols.end - start);
+                let mut b = block.as_mut().subcols_mut(0, w);
+                for j in 0..w {
+                    let col = b.rb_mut().col_mut(j).try_as_col_major_mut().expect("contiguous column").as_slice_mut();
+                    col.fill(0.0);
+                    fill(start + j, col);
+                }
+                LuRef::new_unchecked(&s.lu, numeric).solve_in_place_with_conj(
+                    Conj::No,
+                    b.rb_mut(),
+                    Par::Seq,
+                    MemStack::new(&mut buf),
+                );
+                for j in 0..w {
+                    let x = b.rb().col(j).try_as_col_major().expect("contiguous column").as_slice();
+                    if x.iter().any(|v| !v.is_finite()) {
+                        return None;
+                    }
+                    out.push(take(start + j, x));
+                }
             }
-            handles.into_iter().all(|h| h.join().unwrap_or(false))
+            Some(out)
+        };
+        let threads = threads.clamp(1, ncols.div_ceil(SOLVE_BLOCK).max(1));
+        if threads == 1 {
+            return solve_range(0..ncols);
+        }
+        let chunk = ncols.div_ceil(threads);
+        std::thread::scope(|sc| {
+            let handles: Vec<_> = (0..ncols)
+                .step_by(chunk)
+                .map(|a| {
+                    let solve_range = &solve_range;
+                    sc.spawn(move || solve_range(a..(a + chunk).min(ncols)))
+                })
+                .collect();
+            let mut all = Vec::with_capacity(ncols);
+            for h in handles {
+                match h.join() {
+                    Ok(part) => all.extend(part?),
+                    Err(panic) => std::panic::resume_unwind(panic),
+                }
+            }
+            Some(all)
         })
     }
 

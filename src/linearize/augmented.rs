@@ -1,13 +1,15 @@
 //! The augmented sensitivity system (seed Eq. 34a–34k, Table 1): unknowns
 //! (u̇, q̇, Ẇ, Ṡ, λ, u, q, W, S) differentiated with respect to the virtual states (S̄, W̄)
-//! and the inputs v. One sparse matrix, one sparse LU, all right-hand sides at once
-//! (split over threads). Nothing is reduced to the state-space ODE (Eq. 6).
+//! and the inputs v. One sparse matrix, one sparse LU, the right-hand sides in blocks
+//! (split over threads), keeping only the rows A, B, C, D need. Nothing is reduced to
+//! the state-space ODE (Eq. 6).
 
 use super::jets::{PositionFn, jets};
-use super::outputs::output_gradient;
+use super::outputs::{OutputGradient, output_gradient};
 use super::select::Selection;
 use super::states::VelState;
 use crate::dae::equations::{Layout, jacobian};
+use crate::dae::rank::full_pivot;
 use crate::dae::sparse::{SparseLu, Triplets};
 use crate::dae::{EngineError, Simulator};
 use crate::mechanics::body::NQ;
@@ -115,8 +117,8 @@ impl Blocks {
 const PARTITION_TOL: f64 = 1e-8;
 
 /// Check that the states still parameterize the motion here (the determinant condition
-/// after Eq. 36): full-pivot LU of the square [C_q; s_q].
-fn check_partition(
+/// after Eq. 36): sparse complete-pivoting elimination of the square [C_q; s_q].
+pub fn check_partition(
     sys: &crate::mechanics::System,
     sel: &Selection,
     q: &[f64],
@@ -125,7 +127,7 @@ fn check_partition(
 ) -> Result<(), EngineError> {
     let n = sys.n();
     let zeros = vec![0.0; n];
-    let mut j = Mat::<f64>::zeros(n, n);
+    let mut j: Vec<(usize, usize, f64)> = Vec::new();
     let mut row = 0;
     for el in &sys.constraints {
         for (e, jet) in jets(sys, el, q, &zeros, &zeros, t, inputs).iter().enumerate() {
@@ -134,7 +136,7 @@ fn check_partition(
             }
             for (a, &b) in el.bodies.iter().enumerate() {
                 for c in 0..NQ {
-                    j[(row, NQ * b + c)] = jet.dg[NQ * a + c];
+                    j.push((row, NQ * b + c, jet.dg[NQ * a + c]));
                 }
             }
             row += 1;
@@ -147,22 +149,26 @@ fn check_partition(
         }
         for (a, &b) in st.bodies().iter().enumerate() {
             for c in 0..NQ {
-                j[(row, NQ * b + c)] = jet.dg[NQ * a + c];
+                j.push((row, NQ * b + c, jet.dg[NQ * a + c]));
             }
         }
         row += 1;
     }
-    let lu = j.full_piv_lu();
-    let u = lu.U();
-    let piv: Vec<f64> = (0..n).map(|i| u[(i, i)].abs()).collect();
-    let big = piv.iter().copied().fold(0.0, f64::max);
-    let small = piv.iter().copied().fold(f64::INFINITY, f64::min);
-    if small.is_nan() || small <= PARTITION_TOL * big {
+    // Stops at the first pivot ≤ PARTITION_TOL·largest: then the next candidate is the ratio.
+    let ratio = match full_pivot(n, n, j, PARTITION_TOL, 0.0) {
+        Ok(p) if p.rank == n => {
+            let small = p.magnitudes.iter().copied().fold(f64::INFINITY, f64::min);
+            small / p.largest()
+        }
+        Ok(p) => p.remaining / p.largest().max(p.remaining),
+        Err(_) => f64::NAN,
+    };
+    if ratio.is_nan() || ratio <= PARTITION_TOL {
         return Err(EngineError::Numeric(format!(
             "at t = {t}: the linearization states ({}) no longer parameterize the motion (singular partition, \
              pivot ratio {:.1e}); choose user states (<linearization>) that stay independent",
             sel.states.iter().map(|s| s.name.as_str()).collect::<Vec<_>>().join(", "),
-            small / big
+            ratio
         )));
     }
     Ok(())
@@ -304,23 +310,14 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
         push_z(&mut k, bl.row('i') + i, ws.bodies(), &jet.dwd, -1.0, true);
         k.push(bl.row('j') + i, bl.w() + i, 1.0);
     }
-    // Right-hand sides: ∂/∂S̄ (34k), ∂/∂W̄ (34j), ∂/∂X̄, ∂/∂v (34a: +∂Q/∂v; user rows: −∂r/∂v).
-    let dim = bl.dim();
-    let mut rhs = Mat::<f64>::zeros(dim, ns + ni);
-    for i in 0..s0 {
-        rhs[(bl.row('k') + i, i)] = 1.0;
-    }
-    for i in 0..s1 {
-        rhs[(bl.row('j') + i, s0 + i)] = 1.0;
-    }
-    for i in 0..nx {
-        rhs[(bl.row('x') + i, s0 + s1 + i)] = 1.0;
-    }
+    // Right-hand sides: ∂/∂S̄ (34k), ∂/∂W̄ (34j), ∂/∂X̄, ∂/∂v (34a: +∂Q/∂v; user rows:
+    // −∂r/∂v), the last sparse.
+    let mut dq_dv: Vec<Vec<(usize, f64)>> = vec![Vec::new(); ni];
     for el in &sys.forces {
         for (v, col) in force_ext_jacobian(sys, el, &q, &u, t, inputs) {
             if v < ni {
                 for (a, &val) in col.iter().enumerate() {
-                    rhs[(bl.row('a') + NQ * el.bodies[a / NQ] + a % NQ, ns + v)] += val;
+                    dq_dv[v].push((bl.row('a') + NQ * el.bodies[a / NQ] + a % NQ, val));
                 }
             }
         }
@@ -328,10 +325,81 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
     for (r, ue) in sys.user.iter().enumerate() {
         for (v, val) in user_jacobian(sys, ue, &q, &u, t, inputs).dext {
             if v < ni {
-                rhs[(bl.row('l') + r, ns + v)] -= val;
+                dq_dv[v].push((bl.row('l') + r, -val));
             }
         }
     }
+    let fill = |col: usize, b: &mut [f64]| {
+        if col < s0 {
+            b[bl.row('k') + col] = 1.0;
+        } else if col < s0 + s1 {
+            b[bl.row('j') + col - s0] = 1.0;
+        } else if col < ns {
+            b[bl.row('x') + col - s0 - s1] = 1.0;
+        } else {
+            for &(r, v) in &dq_dv[col - ns] {
+                b[r] += v;
+            }
+        }
+    };
+    let point = super::outputs::Point { q: &q, u: &u, udot: &udot, lam: &lam, t, inputs };
+    let grads: Vec<OutputGradient> =
+        sys.outputs.iter().zip(&sys.output_bases).map(|(e, &abase)| output_gradient(sys, e, abase, point)).collect();
+    // Loads that forces and user rows read (external values): their exact gradients, for
+    // outputs that depend on them indirectly (e.g. the load of a force that reads a load).
+    let lgrads: Vec<Option<LoadGradient>> =
+        sys.load_refs.iter().map(|&r| load_gradient(sys, r, (&q, &u, &lam[..m]), t, &ext[..ni + nz])).collect();
+    // An output's sensitivity in solution column x (chain rule through the q, u, u̇, λ and
+    // Z rows of Eq. 34). Positions and velocities do not depend on the inputs (Eq.
+    // 34d–f, h, j–k hold no input terms), so input columns take no q and u terms: they are
+    // zero and would carry only the LU's round-off.
+    let sens = |g: &OutputGradient, x: &[f64], kinematic: bool| -> f64 {
+        let nql = NQ * g.bodies.len();
+        let mut v = 0.0;
+        for a in 0..nql {
+            let gi = NQ * g.bodies[a / NQ] + a % NQ;
+            if kinematic {
+                v += g.dz[a] * x[bl.q() + gi] + g.dz[nql + a] * x[bl.u() + gi];
+            }
+            v += g.dz[2 * nql + a] * x[bl.ud() + gi];
+        }
+        for &(row, w) in &g.dlam {
+            v += w * x[bl.lam() + row];
+        }
+        for (zi, &dy) in g.dv[ni..ni + nz].iter().enumerate() {
+            if dy != 0.0 {
+                v += dy * x[bl.z() + zi];
+            }
+        }
+        for (li, &dy) in g.dv[ni + nz..].iter().enumerate() {
+            let Some(lg) = lgrads[li / NLOAD].as_ref().filter(|_| dy != 0.0) else { continue };
+            let (c, nlb, neq) = (li % NLOAD, NQ * lg.bodies.len(), lg.neq());
+            for a in 0..nlb {
+                let gi = NQ * lg.bodies[a / NQ] + a % NQ;
+                if kinematic {
+                    v += dy * lg.dz[c * 2 * nlb + a] * x[bl.q() + gi];
+                    v += dy * lg.dz[c * 2 * nlb + nlb + a] * x[bl.u() + gi];
+                }
+            }
+            for k in 0..neq {
+                v += dy * lg.dlam[c * neq + k] * x[bl.lam() + lg.lam_row + k];
+            }
+            for zi in 0..nz {
+                v += dy * lg.dv.get(c * (ni + nz) + ni + zi).copied().unwrap_or(0.0) * x[bl.z() + zi];
+            }
+        }
+        v
+    };
+    // Kept of each solution: Ṡ, Ẇ, Ẋ (a column of A or B) and the outputs' sensitivities
+    // (a column of C or D without the direct ∂y/∂v).
+    let take = |col: usize, x: &[f64]| -> Vec<f64> {
+        let mut keep = Vec::with_capacity(ns + grads.len());
+        keep.extend_from_slice(&x[bl.sd()..bl.sd() + s0]);
+        keep.extend_from_slice(&x[bl.wd()..bl.wd() + s1]);
+        keep.extend_from_slice(&x[bl.z() + nx..bl.z() + 2 * nx]);
+        keep.extend(grads.iter().map(|g| sens(g, x, col < ns)));
+        keep
+    };
     let mut lu = SparseLu::new();
     let singular = || {
         EngineError::Numeric(format!(
@@ -345,25 +413,13 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
                 .join(", ")
         ))
     };
-    lu.factor(dim, &k).map_err(|_| singular())?;
-    if !lu.solve_parallel(rhs.as_mut(), threads) {
-        return Err(singular());
-    }
-    // A and B: rows Ṡ, Ẇ, Ẋ of the solution.
-    let pick = |r: usize, c: usize| {
-        if r < s0 {
-            rhs[(bl.sd() + r, c)]
-        } else if r < s0 + s1 {
-            rhs[(bl.wd() + r - s0, c)]
-        } else {
-            rhs[(bl.z() + nx + r - s0 - s1, c)]
-        }
-    };
-    let a = Mat::from_fn(ns, ns, pick);
-    let b = Mat::from_fn(ns, ni, |r, c| pick(r, ns + c));
-    // Where W_j = Ṡ_r (always without non-holonomic constraints), the Ṡ rows of A and B are exactly
-    // [0 I 0] and 0 (Eq. 34g–h), without the LU's round-off (the FMU's structural zeros are zeros).
-    let (mut a, mut b) = (a, b);
+    lu.factor(bl.dim(), &k).map_err(|_| singular())?;
+    let sol = lu.solve_columns(ns + ni, threads, fill, take).ok_or_else(singular)?;
+    let mut a = Mat::from_fn(ns, ns, |r, c| sol[c][r]);
+    let mut b = Mat::from_fn(ns, ni, |r, v| sol[ns + v][r]);
+    // Where W_j = Ṡ_r (always without non-holonomic constraints), the Ṡ rows of A and B are
+    // exactly [0 I 0] and 0 (Eq. 34g–h), without the LU's round-off (the FMU's structural
+    // zeros are zeros).
     for r in 0..s0 {
         let w =
             sel.velocities.iter().position(|w| matches!(w, VelState::Derivative(d) if d.name == sel.states[r].name));
@@ -376,65 +432,10 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
             }
         }
     }
-    // C and D: chain rule through the q, u, u̇, λ (element loads) and Z sensitivities
-    // (solution rows of Eq. 34). Positions and velocities do not depend on the inputs
-    // (Eq. 34d–f, h, j–k hold no input terms), so D takes no q and u terms: they are zero
-    // and would carry only the LU's round-off.
-    let no = sys.outputs.len();
-    let mut c = Mat::<f64>::zeros(no, ns);
-    let mut d = Mat::<f64>::zeros(no, ni);
-    let point = super::outputs::Point { q: &q, u: &u, udot: &udot, lam: &lam, t, inputs };
-    // Loads that forces and user rows read (external values): their exact gradients, for
-    // outputs that depend on them indirectly (e.g. the load of a force that reads a load).
-    let lgrads: Vec<Option<LoadGradient>> =
-        sys.load_refs.iter().map(|&r| load_gradient(sys, r, (&q, &u, &lam[..m]), t, &ext[..ni + nz])).collect();
-    for (o, (e, &abase)) in sys.outputs.iter().zip(&sys.output_bases).enumerate() {
-        let g = output_gradient(sys, e, abase, point);
-        let nql = NQ * g.bodies.len();
-        let sens = |col: usize| -> f64 {
-            let kinematic = col < ns;
-            let mut v = 0.0;
-            for a in 0..nql {
-                let gi = NQ * g.bodies[a / NQ] + a % NQ;
-                if kinematic {
-                    v += g.dz[a] * rhs[(bl.q() + gi, col)] + g.dz[nql + a] * rhs[(bl.u() + gi, col)];
-                }
-                v += g.dz[2 * nql + a] * rhs[(bl.ud() + gi, col)];
-            }
-            for &(row, w) in &g.dlam {
-                v += w * rhs[(bl.lam() + row, col)];
-            }
-            for (zi, &dy) in g.dv[ni..ni + nz].iter().enumerate() {
-                if dy != 0.0 {
-                    v += dy * rhs[(bl.z() + zi, col)];
-                }
-            }
-            for (li, &dy) in g.dv[ni + nz..].iter().enumerate() {
-                let Some(lg) = lgrads[li / NLOAD].as_ref().filter(|_| dy != 0.0) else { continue };
-                let (c, nlb, neq) = (li % NLOAD, NQ * lg.bodies.len(), lg.neq());
-                for a in 0..nlb {
-                    let gi = NQ * lg.bodies[a / NQ] + a % NQ;
-                    if kinematic {
-                        v += dy * lg.dz[c * 2 * nlb + a] * rhs[(bl.q() + gi, col)];
-                        v += dy * lg.dz[c * 2 * nlb + nlb + a] * rhs[(bl.u() + gi, col)];
-                    }
-                }
-                for k in 0..neq {
-                    v += dy * lg.dlam[c * neq + k] * rhs[(bl.lam() + lg.lam_row + k, col)];
-                }
-                for zi in 0..nz {
-                    let d = lg.dv.get(c * (ni + nz) + ni + zi).copied().unwrap_or(0.0);
-                    v += dy * d * rhs[(bl.z() + zi, col)];
-                }
-            }
-            v
-        };
-        for col in 0..ns {
-            c[(o, col)] = sens(col);
-        }
-        for v in 0..ni {
-            d[(o, v)] = sens(ns + v) + g.dv[v];
-        }
+    let no = grads.len();
+    let c = Mat::from_fn(no, ns, |o, col| sol[col][ns + o]);
+    let d = Mat::from_fn(no, ni, |o, v| sol[ns + v][ns + o] + grads[o].dv[v]);
+    for o in 0..no {
         if (0..ns).any(|col| !c[(o, col)].is_finite()) || (0..ni).any(|v| !d[(o, v)].is_finite()) {
             return Err(EngineError::Numeric(format!(
                 "output '{}' has no finite derivative here (e.g. |v| at v = 0, or the load of a user constraint)",

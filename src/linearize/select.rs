@@ -1,4 +1,4 @@
-//! State selection (seed Eq. 30–33): factor J = [C_q 0; −ŝ_q D] with full pivoting, rows of
+//! State selection (seed Eq. 30–33): factor J = [C_q 0; −ŝ_q D] with full pivoting (sparse), rows of
 //! user states weighted up and D a small diagonal, so the pivots (dependent coordinates)
 //! are taken among q first and the user states stay independent. The columns left without
 //! a pivot are the states S: user states first, completed with internal coordinates when
@@ -7,16 +7,16 @@
 use super::jets::{PositionFn, jets};
 use super::select_velocity::{derivative_states, select_velocities};
 use super::states::{StateFn, VelState, internal_state, user_states};
+use crate::dae::rank::full_pivot;
 use crate::mechanics::System;
 use crate::mechanics::body::NQ;
 use crate::mechanics::kernels::constraint_first;
-use faer::Mat;
 
 /// Weight of user-state rows relative to constraint rows (Eq. 33's row weighting).
 pub const USER_ROW_WEIGHT: f64 = 1e3;
 /// The small diagonal D replacing the identity in Eq. 33 (biases column pivoting).
 pub const D_SMALL: f64 = 1e-3;
-/// A pivot below this fraction of the largest |J| entry counts as zero (rank decision).
+/// A pivot below this fraction of the largest pivot (at least 1) counts as zero (rank decision).
 pub const RANK_TOL: f64 = 1e-9;
 
 /// The chosen states and what was dropped.
@@ -40,16 +40,16 @@ pub fn select_states(sys: &System, q: &[f64], t: f64, inputs: &[f64]) -> Result<
     let users = user_states(sys);
     let nu = users.len();
     let (rows, cols) = (m + nu, n + nu);
-    let mut j = Mat::<f64>::zeros(rows, cols);
+    let mut j: Vec<(usize, usize, f64)> = Vec::new();
     for el in &sys.constraints {
         let f = constraint_first(sys, el, q, t, inputs);
         let nql = NQ * el.bodies.len();
         for e in 0..el.neq {
             if sys.redundant[el.row + e] {
-                continue; // left as a zero row: it adds no rank
+                continue; // left out: it adds no rank
             }
             for a in 0..nql {
-                j[(el.row + e, NQ * el.bodies[a / NQ] + a % NQ)] += f.cq[e * nql + a];
+                j.push((el.row + e, NQ * el.bodies[a / NQ] + a % NQ, f.cq[e * nql + a]));
             }
         }
     }
@@ -61,30 +61,25 @@ pub fn select_states(sys: &System, q: &[f64], t: f64, inputs: &[f64]) -> Result<
         }
         for (a, &b) in s.bodies().iter().enumerate() {
             for c in 0..NQ {
-                j[(m + k, NQ * b + c)] = -USER_ROW_WEIGHT * g.dg[NQ * a + c];
+                j.push((m + k, NQ * b + c, -USER_ROW_WEIGHT * g.dg[NQ * a + c]));
             }
         }
-        j[(m + k, n + k)] = USER_ROW_WEIGHT * D_SMALL;
+        j.push((m + k, n + k, USER_ROW_WEIGHT * D_SMALL));
     }
-    // Full-pivot Gaussian elimination; faer's full_piv_lu gives the column order.
-    let lu = j.full_piv_lu();
-    let u = lu.U();
-    let big = (0..rows.min(cols)).map(|i| u[(i, i)].abs()).fold(0.0, f64::max).max(1.0);
-    let rank = (0..rows.min(cols)).take_while(|&i| u[(i, i)].abs() > RANK_TOL * big).count();
-    let perm = lu.Q().arrays().0.to_vec();
-    let free: Vec<usize> = perm[rank..].to_vec();
-    let pivoted: Vec<usize> = perm[..rank].to_vec();
+    // Sparse Gaussian elimination with complete pivoting (Eq. 33); pivots > RANK_TOL·max(largest, 1).
+    let piv = full_pivot(rows, cols, j, RANK_TOL, 1.0)
+        .map_err(|e| format!("the constraint Jacobian is not finite here ({e})"))?;
+    let rank = piv.rank;
+    let pivoted = piv.pivoted_cols(cols);
     let mut states: Vec<StateFn> = Vec::new();
     for (k, user) in users.iter().enumerate() {
-        if free.contains(&(n + k)) {
+        if !pivoted[n + k] {
             states.push(user.clone());
         }
     }
-    let mut internal: Vec<usize> = free.iter().copied().filter(|&c| c < n).collect();
-    internal.sort_unstable();
+    let internal: Vec<usize> = (0..n).filter(|&c| !pivoted[c]).collect();
     states.extend(internal.iter().map(|&c| internal_state(sys, c)));
-    let mut dropped: Vec<String> =
-        (0..nu).filter(|k| pivoted.contains(&(n + k))).map(|k| users[k].name.clone()).collect();
+    let mut dropped: Vec<String> = (0..nu).filter(|&k| pivoted[n + k]).map(|k| users[k].name.clone()).collect();
     let velocities = if sys.mn == 0 {
         derivative_states(&states)
     } else {
