@@ -56,6 +56,9 @@ const KITCHEN_SINK: &str = r#"<multibody name="sink" version="1">
   <variable name="fric" function="0.2*sqrt(fz(jrev)^2 + 0.01) + 0.1*fx(st) - 0.05*ty(jsph)"/>
   <sforce name="fu" type="translational" i="a.cm" j="c.cm" function="2*loop1 + filt*v - xi + fric"/>
   <gforce name="g4" i="c.cm" force="0.3*fy(jrev) 0 tz(mrot)" torque="0 0 0.1*fx(g2)"/>
+  <sforce name="added_mass" type="translational" i="b.cm" j="ground.O" function="-0.4*accx(b.cm, ground.O, b.m1) + 0.1*wdtz(a.m2)"/>
+  <variable name="acc_var" function="0.2*accz(c.cm) + 0.1*loop1"/>
+  <gforce name="g5" i="a.cm" force="acc_var 0 0"/>
   <gforce name="g3" i="b.cm" force="loop2 dif1(filt) 0" torque="0 0 xi*wz(b.cm)"/>
 </multibody>"#;
 
@@ -72,7 +75,7 @@ fn setup() -> (System, Layout, Vec<f64>) {
     let model = load_str(KITCHEN_SINK, "sink.xml").unwrap_or_else(|e| panic!("{e}"));
     let sys = System::from_model(&model).unwrap();
     let lay = Layout::of(&sys);
-    assert_eq!((lay.nx, lay.nv), (2, 3));
+    assert_eq!((lay.nx, lay.nv, lay.na), (2, 4, 18));
     assert_eq!(sys.load_refs.len(), 5);
     let mut seed = 7;
     let mut y = vec![0.0; lay.dim()];

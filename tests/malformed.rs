@@ -172,9 +172,9 @@ case!(
 );
 
 case!(
-    m27_sforce_uses_acceleration,
-    "27_sforce_uses_acceleration.xml",
-    "27_sforce_uses_acceleration.xml:4:60: sforce 's': forces and user elements depending on accelerations are not supported yet"
+    m27_implicit_without_rate,
+    "27_implicit_without_rate.xml",
+    "27_implicit_without_rate.xml:3:52: differential 'x': implicit: 'function' must use dif1(x)"
 );
 
 case!(

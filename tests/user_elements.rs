@@ -173,3 +173,42 @@ fn pid_loop_simulates_back_to_upright_like_its_linearization() {
     assert!(worst < 1e-5, "nonlinear vs linear angle: {worst:e}");
     assert!(x[1].abs() < 0.2 * th0, "the loop is stable: th(3) = {}", x[1]);
 }
+
+const ADDED_MASS: &str = r#"<multibody name="added_mass" version="1">
+  <parameter name="m" value="2"/>
+  <parameter name="ma" value="0.5" description="added (fluid) mass"/>
+  <parameter name="k" value="50"/>
+  <ground><marker name="rail" position="0 0 0" z_axis="1 0 0" x_axis="0 1 0"/></ground>
+  <body name="b" mass="m" inertia="1 1 1" position="0.1 0 0">
+    <marker name="s" position="0 0 0" z_axis="1 0 0" x_axis="0 1 0"/>
+  </body>
+  <joint name="slide" type="translational" i="b.s" j="ground.rail"/>
+  <spring_damper name="spring" type="translational" i="b.cm" j="ground.rail" stiffness="k" damping="0" length="0"/>
+  <variable name="drag" function="-ma*accx(b.cm)"/>
+  <gforce name="fluid" i="b.cm" force="drag 0 0"/>
+  <output name="x" function="dx(b.cm)"/>
+  <output name="drag_out" function="drag"/>
+</multibody>"#;
+
+#[test]
+fn a_force_proportional_to_acceleration_acts_as_added_mass() {
+    // F = −m_a ẍ (through a variable): (m + m_a) ẍ = −k x, ω = sqrt(k / (m + m_a)) = 4.4721.
+    // Linearization: eigenvalues ±iω to 1e-9 relative (exact). Simulation from x0 = 0.1 at
+    // rest: x = x0 cos ωt to 1e-7 over 2 s (tol 1e-10; global error ≈ 100·tol), and the
+    // drag output equals m_a ω² x (1e-6).
+    let m = load_str(ADDED_MASS, "added_mass.xml").unwrap();
+    let w = (50.0f64 / 2.5).sqrt();
+    let lin = lin_at_start(&m);
+    let rows = eigen_table(&lin.a).unwrap();
+    assert_eq!(rows.len(), 1, "{rows:?}");
+    assert!((rows[0].im.abs() - w).abs() < 1e-9 * w && rows[0].re.abs() < 1e-9 * w, "{rows:?}");
+    let mut sim = Simulator::new(&m, SimOptions { tol: 1e-10, max_step: None }, 0.0).unwrap();
+    for k in 1..=20 {
+        let t = 0.1 * k as f64;
+        sim.advance(t).unwrap();
+        let y = sim.outputs().unwrap();
+        let x = 0.1 * (w * t).cos();
+        assert!((y[0] - x).abs() < 1e-7, "t = {t}: x = {} want {x}", y[0]);
+        assert!((y[1] - 0.5 * w * w * y[0]).abs() < 1e-6, "t = {t}: drag {} want {}", y[1], 0.5 * w * w * y[0]);
+    }
+}

@@ -27,16 +27,22 @@ pub struct Layout {
     pub nv: usize,
     /// Non-holonomic equations (multipliers ν).
     pub mn: usize,
+    /// Acceleration unknowns a (6 per body whose accelerations forces or user rows read).
+    pub na: usize,
 }
 
 impl Layout {
     /// The layout of a system's equations.
     pub fn of(sys: &System) -> Layout {
-        Layout { n: sys.n(), m: sys.m, nx: sys.nx, nv: sys.nv, mn: sys.mn }
+        Layout { n: sys.n(), m: sys.m, nx: sys.nx, nv: sys.nv, mn: sys.mn, na: NQ * sys.acc_bodies.len() }
     }
-    /// Number of user unknowns Z = (X, Ẋ, V).
+    /// Number of user unknowns Z = (X, Ẋ, V, a).
     pub fn nz(&self) -> usize {
-        2 * self.nx + self.nv
+        2 * self.nx + self.nv + self.na
+    }
+    /// Offset of the acceleration unknowns a (inside Z).
+    pub fn acc(&self) -> usize {
+        self.z() + 2 * self.nx + self.nv
     }
     /// Total dimension 2n + nz + 2m + mn.
     pub fn dim(&self) -> usize {
@@ -156,6 +162,15 @@ pub fn rhs(sys: &System, lay: Layout, t: f64, y: &[f64], inputs: &[f64], f: &mut
                 f[nu + g] -= p[a] * lam;
                 f[g] -= cq[a] * mu;
             }
+        }
+    }
+    // Bodies with acceleration unknowns: u' = a, and M a = Q − Pᵀλ − Bᵀν as algebraic rows.
+    for (k, &b) in sys.acc_bodies.iter().enumerate() {
+        let (o, ra) = (nu + NQ * b, lay.acc() + NQ * k);
+        let ma = mass_times(&sys.bodies[b], &y[ra..ra + NQ]);
+        for c in 0..NQ {
+            f[ra + c] = f[o + c] - ma[c];
+            f[o + c] = y[ra + c];
         }
     }
 }
@@ -333,6 +348,36 @@ pub fn jacobian(sys: &System, lay: Layout, t: f64, y: &[f64], inputs: &[f64], ja
             }
         }
     }
+    // Bodies with acceleration unknowns: their u-row entries belong to the algebraic rows
+    // M a − (Q − Pᵀλ − Bᵀν) (moved, then −M), and the u rows become u' = a.
+    if !sys.acc_bodies.is_empty() {
+        let mut row_of = std::collections::HashMap::new();
+        for (k, &b) in sys.acc_bodies.iter().enumerate() {
+            for c in 0..NQ {
+                row_of.insert(nu + NQ * b + c, lay.acc() + NQ * k + c);
+            }
+        }
+        for p in jac.idx.iter_mut() {
+            if let Some(&r) = row_of.get(&p.row) {
+                p.row = r;
+            }
+        }
+        for (k, &b) in sys.acc_bodies.iter().enumerate() {
+            let ra = lay.acc() + NQ * k;
+            let body = &sys.bodies[b];
+            for c in 0..3 {
+                jac.push(ra + c, ra + c, -body.mass);
+            }
+            for r in 0..3 {
+                for c in 0..3 {
+                    jac.push(ra + 3 + r, ra + 3 + c, -body.inertia[r][c]);
+                }
+            }
+            for c in 0..NQ {
+                jac.push(nu + NQ * b + c, ra + c, 1.0);
+            }
+        }
+    }
 }
 
 /// The constant mass matrix diag(I, M, [I 0 0], 0, 0) of the integrator's M y' = f.
@@ -345,6 +390,12 @@ pub fn mass_matrix(sys: &System, lay: Layout, m: &mut Triplets) {
     }
     for (b, body) in sys.bodies.iter().enumerate() {
         let o = lay.u() + NQ * b;
+        if sys.acc_bodies.contains(&b) {
+            for c in 0..NQ {
+                m.push(o + c, o + c, 1.0); // u' = a
+            }
+            continue;
+        }
         for c in 0..3 {
             m.push(o + c, o + c, body.mass);
         }
@@ -472,4 +523,14 @@ impl LoadChain {
             }
         }
     }
+}
+
+/// M_b a for one body (a = [v̇; ω̇'], constant mass matrix).
+fn mass_times(body: &crate::mechanics::system::BodyProps, a: &[f64]) -> [f64; NQ] {
+    let mut out = [0.0; NQ];
+    for c in 0..3 {
+        out[c] = body.mass * a[c];
+        out[3 + c] = (0..3).map(|k| body.inertia[c][k] * a[3 + k]).sum();
+    }
+    out
 }

@@ -369,7 +369,7 @@ pub fn user_unknowns(
             let uj = user_jacobian(sys, ue, q, u, t, &ext);
             r[(row, 0)] = -uj.value;
             for (e, v) in uj.dext {
-                if e >= ni + nx && e < ni + sys.nz() {
+                if e >= ni + nx && e < ni + 2 * nx + sys.nv {
                     jac[(row, e - ni - nx)] += v;
                 }
             }
@@ -404,20 +404,33 @@ pub fn consistent_accelerations(
     lu: &mut SparseLu,
 ) -> Result<(Vec<f64>, Vec<f64>), String> {
     let mut lam: Option<Vec<f64>> = None;
+    let a0 = 2 * sys.nx + sys.nv;
     for _ in 0..200 {
         user_unknowns(sys, q, u, lam.as_deref(), t, inputs, z)?;
         let ext = sys.ext(inputs, z, lam.as_deref().map(|l| (q, u, l)), t);
         let (udot, new) = accelerations(sys, q, u, t, &ext, lu)?;
-        if sys.load_refs.is_empty() {
+        if sys.load_refs.is_empty() && sys.acc_bodies.is_empty() {
             return Ok((udot, new));
         }
+        // Accelerations read by forces: the unknowns a follow u̇ (fixed point with λ).
+        let mut change_a = 0.0f64;
+        for (k, &b) in sys.acc_bodies.iter().enumerate() {
+            for c in 0..NQ {
+                let (old, v) = (z[a0 + NQ * k + c], udot[NQ * b + c]);
+                change_a = change_a.max((old - v).abs() / (1.0 + v.abs()));
+                z[a0 + NQ * k + c] = v;
+            }
+        }
         let scale = 1.0 + new.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        let change =
-            lam.as_ref().map_or(f64::INFINITY, |l| l.iter().zip(&new).fold(0.0f64, |a, (x, y)| a.max((x - y).abs())));
-        if change <= 1e-13 * scale {
+        let change = match (&lam, sys.load_refs.is_empty()) {
+            (_, true) => 0.0,
+            (None, false) => f64::INFINITY,
+            (Some(l), false) => l.iter().zip(&new).fold(0.0f64, |a, (x, y)| a.max((x - y).abs())),
+        };
+        if change <= 1e-13 * scale && change_a <= 1e-13 {
             return Ok((udot, new));
         }
         lam = Some(new);
     }
-    Err("the algebraic loop through element loads does not converge at the initial state".into())
+    Err("the algebraic loop through element loads or accelerations does not converge at the initial state".into())
 }

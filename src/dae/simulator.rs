@@ -166,8 +166,10 @@ impl DaeProblem for MultibodyDae {
         equations::mass_matrix(&self.sys, self.lay, m);
     }
     fn index(&self) -> Vec<u8> {
-        // q, u, X and the index-1 user unknowns (Ẋ, V): error-controlled; λ, μ: index 2.
-        (0..self.lay.dim()).map(|i| if i < self.lay.lam() { 0 } else { 2 }).collect()
+        // q, u, X and the index-1 user unknowns (Ẋ, V): error-controlled; accelerations a
+        // (solved with λ from the velocity constraints), λ, ν, μ: index 2.
+        let a0 = self.lay.acc();
+        (0..self.lay.dim()).map(|i| if i < a0 { 0 } else { 2 }).collect()
     }
     fn accepted(&mut self, t: f64, y: &mut [f64]) -> bool {
         let mut changed = false;
@@ -340,7 +342,7 @@ impl Simulator {
             let (q, u) = (self.q().to_vec(), self.u().to_vec());
             let s = &self.dae;
             let t = self.radau.t;
-            self.acc = Some(if s.sys.load_refs.is_empty() {
+            self.acc = Some(if s.sys.load_refs.is_empty() && s.sys.acc_bodies.is_empty() {
                 let ext = self.ext();
                 init::accelerations(&s.sys, &q, &u, t, &ext, &mut self.acc_lu).map_err(EngineError::Numeric)?
             } else {
@@ -552,7 +554,15 @@ impl Simulator {
         let (n, m, t) = (self.dae.lay.n, self.dae.sys.m, self.radau.t);
         let y = &self.radau.y;
         let state = (&y[..n], &y[n..2 * n], &lam[..m]);
-        self.dae.sys.ext(&self.dae.inputs_at(t), self.user_values(), Some(state), t)
+        let mut z = self.user_values().to_vec();
+        // Acceleration unknowns: those of the same solve as λ.
+        if let Some((udot, _)) = &self.acc {
+            let a0 = self.dae.lay.acc() - self.dae.lay.z();
+            for (k, &b) in self.dae.sys.acc_bodies.iter().enumerate() {
+                z[a0 + NQ * k..a0 + NQ * k + NQ].copy_from_slice(&udot[NQ * b..NQ * b + NQ]);
+            }
+        }
+        self.dae.sys.ext(&self.dae.inputs_at(t), &z, Some(state), t)
     }
 
     /// Current user unknowns Z = (X, Ẋ, V).

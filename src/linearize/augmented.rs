@@ -252,6 +252,13 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
     }
     for (b, body) in sys.bodies.iter().enumerate() {
         let o = NQ * b;
+        if sys.acc_bodies.contains(&b) {
+            // u̇ = a (the force balance is an algebraic row among the user rows).
+            for c in 0..NQ {
+                k.push(bl.row('a') + o + c, bl.ud() + o + c, 1.0);
+            }
+            continue;
+        }
         for c in 0..3 {
             k.push(bl.row('a') + o + c, bl.ud() + o + c, body.mass);
         }
@@ -317,7 +324,13 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
         for (v, col) in force_ext_jacobian(sys, el, &q, &u, t, inputs) {
             if v < ni {
                 for (a, &val) in col.iter().enumerate() {
-                    dq_dv[v].push((bl.row('a') + NQ * el.bodies[a / NQ] + a % NQ, val));
+                    let b = el.bodies[a / NQ];
+                    match sys.acc_bodies.iter().position(|&x| x == b) {
+                        // The force balance of a body with acceleration unknowns is an
+                        // algebraic row f = Q − … − M a among the user rows.
+                        Some(kb) => dq_dv[v].push((bl.row('l') + nx + sys.nv + NQ * kb + a % NQ, -val)),
+                        None => dq_dv[v].push((bl.row('a') + NQ * b + a % NQ, val)),
+                    }
                 }
             }
         }

@@ -43,6 +43,8 @@ pub struct LocalCtx<'a, T: Real> {
     angle_base: Cell<usize>,
     /// When set, every unwrapped angle is recorded as (global slot, value).
     pub record: Option<&'a RefCell<Vec<(usize, f64)>>>,
+    /// Whether accelerations were given (else they are zero, or external values).
+    has_udot: bool,
     /// When set, inputs and user unknowns read these (e.g. seeded dual numbers, same
     /// layout as `inputs`) instead of `inputs`.
     pub input_values: Option<Vec<T>>,
@@ -70,6 +72,7 @@ impl<'a, T: Real> LocalCtx<'a, T> {
             t,
             inputs,
             loads: None,
+            has_udot: !udot.is_empty(),
             angle_base: Cell::new(0),
             record: None,
             input_values: None,
@@ -145,9 +148,18 @@ impl<T: Real> ExprEnv<T> for LocalCtx<'_, T> {
         match self.marker_body(m) {
             None => Twist { v: V3::zero(), w: V3::zero() },
             Some(b) => {
+                // Without given accelerations, a body whose accelerations are unknowns of
+                // the DAE (`System::acc_bodies`) reads them from the external values.
+                let (acc, wdot) = match (self.has_udot, self.sys.markers[m].body.and_then(|g| self.sys.ext_acc(g))) {
+                    (false, Some(k)) => {
+                        let e = |c: usize| self.ext_value(k + c);
+                        (V3([e(0), e(1), e(2)]), V3([e(3), e(4), e(5)]))
+                    }
+                    _ => (b.acc, b.wdot),
+                };
                 let s = self.offset(m);
-                let rel = b.wdot.cross(&s) + b.w.cross(&b.w.cross(&s));
-                Twist { v: b.acc + b.a.mv(&rel), w: b.a.mv(&b.wdot) }
+                let rel = wdot.cross(&s) + b.w.cross(&b.w.cross(&s));
+                Twist { v: acc + b.a.mv(&rel), w: b.a.mv(&wdot) }
             }
         }
     }

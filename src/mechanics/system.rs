@@ -64,6 +64,9 @@ pub struct System {
     /// components are external values, evaluated from (q, u, λ) (algebraic loops through
     /// constraint forces are solved with the equations of motion).
     pub load_refs: Vec<ElementRef>,
+    /// Bodies whose accelerations forces and user rows read: their u̇ become algebraic
+    /// unknowns of the DAE (u' = a, M a = Q − Pᵀλ − Bᵀν), part of Z after V.
+    pub acc_bodies: Vec<usize>,
     /// Number of differential states X and of variables V.
     pub nx: usize,
     pub nv: usize,
@@ -311,7 +314,22 @@ impl System {
                 return Err(format!("a force or user element reads a load that cannot be used there: {msg}"));
             }
         }
-        let refs = |es: &[&Expr]| ext_refs(ni, nx, nv, &load_refs, es);
+        let mut acc_bodies: Vec<usize> = Vec::new();
+        {
+            let mut es: Vec<&Expr> = model.sforces.iter().map(|s| &s.function).collect();
+            es.extend(model.gforces.iter().flat_map(|g| g.force.iter().chain(g.torque.iter())));
+            es.extend(model.variables.iter().map(|v| &v.function));
+            es.extend(model.differentials.iter().map(|d| &d.function));
+            for e in es {
+                let d = deps(e);
+                if d.level >= 2 {
+                    acc_bodies.extend(d.markers.iter().filter_map(|&m| body_of(m)));
+                }
+            }
+            acc_bodies.sort_unstable();
+            acc_bodies.dedup();
+        }
+        let refs = |es: &[&Expr]| ext_refs(ni, nx, nv, &acc_bodies, &load_refs, &body_of, es);
         let mut forces = Vec::new();
         for s in &model.spring_dampers {
             let kind = ForceKind::SpringDamper {
@@ -437,6 +455,7 @@ impl System {
             mn,
             user,
             load_refs,
+            acc_bodies,
             nx,
             nv: model.variables.len(),
             x_init: model.differentials.iter().map(|d| d.start.value).collect(),

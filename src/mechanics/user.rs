@@ -3,6 +3,7 @@
 //! implicit (f(Ẋ, X, …) = 0) differentials and variables (V = g) are all algebraic rows
 //! r(q, u, Z, v, t) = 0, and X' = Ẋ is the differential part.
 
+use super::body::NQ;
 use super::loads::NLOAD;
 use super::local::LocalCtx;
 use super::system::System;
@@ -48,13 +49,30 @@ impl UserEq {
     }
 }
 
-/// Entries of the external values (inputs, X, Ẋ, V, element loads L) that the
-/// expressions `es` read; `load_refs` lists the elements whose loads are external values.
-pub fn ext_refs(sys_ni: usize, nx: usize, nv: usize, load_refs: &[ElementRef], es: &[&Expr]) -> Vec<usize> {
+/// Entries of the external values (inputs, X, Ẋ, V, accelerations A, element loads L)
+/// that the expressions `es` read; `acc_bodies` and `load_refs` list the bodies whose
+/// accelerations and the elements whose loads are external values; `body_of` maps markers.
+pub fn ext_refs(
+    sys_ni: usize,
+    nx: usize,
+    nv: usize,
+    acc_bodies: &[usize],
+    load_refs: &[ElementRef],
+    body_of: &dyn Fn(usize) -> Option<usize>,
+    es: &[&Expr],
+) -> Vec<usize> {
     let mut r = Vec::new();
-    let l0 = sys_ni + 2 * nx + nv;
+    let a0 = sys_ni + 2 * nx + nv;
+    let l0 = a0 + NQ * acc_bodies.len();
     for e in es {
         let d = deps(e);
+        if d.level >= 2 {
+            for b in d.markers.iter().filter_map(|&m| body_of(m)) {
+                if let Some(k) = acc_bodies.iter().position(|&x| x == b) {
+                    r.extend((0..NQ).map(|c| a0 + NQ * k + c));
+                }
+            }
+        }
         r.extend(d.inputs.iter().copied());
         r.extend(d.diffs.iter().map(|&i| sys_ni + i));
         r.extend(d.diff_dots.iter().map(|&i| sys_ni + nx + i));
@@ -77,7 +95,12 @@ impl System {
     }
     /// Number of user unknowns Z = (X, Ẋ, V).
     pub fn nz(&self) -> usize {
-        2 * self.nx + self.nv
+        2 * self.nx + self.nv + NQ * self.acc_bodies.len()
+    }
+    /// External-value index of the first acceleration component (v̇, then ω̇' in body axes)
+    /// of body `b`, if forces or user elements read its accelerations.
+    pub fn ext_acc(&self, b: usize) -> Option<usize> {
+        self.acc_bodies.iter().position(|&x| x == b).map(|k| self.ni() + 2 * self.nx + self.nv + NQ * k)
     }
     /// External-value index of differential state X_i.
     pub fn ext_diff(&self, i: usize) -> usize {

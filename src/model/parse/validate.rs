@@ -41,7 +41,7 @@ pub(crate) enum Allowed {
     Positions,
     /// Positions, velocities, time, parameters (linearization velocities).
     Velocities,
-    /// Forces, variables, differentials: anything but accelerations.
+    /// Forces, variables, differentials: anything.
     Force,
     /// Outputs: anything.
     Any,
@@ -52,9 +52,6 @@ pub(crate) fn check_deps(el: &El, attr: &str, e: &Expr, allowed: Allowed) -> Res
     let d = expr::deps(e);
     let at = el.get(attr).map_or(el.x.pos, |a| a.pos);
     if allowed == Allowed::Force {
-        if d.level >= 2 {
-            return Err(el.err_at(at, "forces and user elements depending on accelerations are not supported yet"));
-        }
         return Ok(());
     }
     if allowed == Allowed::Any {
