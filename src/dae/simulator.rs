@@ -232,8 +232,12 @@ impl MultibodyDae {
             for (e, &b) in sys.outputs.iter().zip(&sys.output_bases) {
                 ctx.eval_expr(e, b);
             }
-            for (_, e, b) in &sys.lin_states {
+            for (_, e, b) in sys.lin_states.iter().chain(&sys.lin_velocities) {
                 ctx.eval_expr(e, *b);
+            }
+            for el in &sys.nonholonomic {
+                let mut out = vec![0.0; el.neq];
+                el.kind.eval(&ctx, &mut out);
             }
         }
         for (g, v) in rec.into_inner() {

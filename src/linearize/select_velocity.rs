@@ -9,10 +9,10 @@ use super::jets::jets;
 use super::select::{D_SMALL, RANK_TOL, USER_ROW_WEIGHT};
 use super::states::{StateFn, VelState, internal_state, user_states, user_velocities};
 use crate::dae::equations::nonholonomic_b;
+use crate::dae::rank::full_pivot;
 use crate::mechanics::System;
 use crate::mechanics::body::NQ;
 use crate::mechanics::kernels::constraint_first;
-use faer::Mat;
 
 /// Preference of explicit `<velocity>` candidates over derivatives of user position states:
 /// their rows weigh this much more and their D entries this much less, so full pivoting
@@ -90,46 +90,36 @@ pub fn select_velocities(
         rows.push(row);
     }
     let nr = rows.len();
-    let mut j = Mat::<f64>::zeros(nr + nc, n + nc);
+    let mut j: Vec<(usize, usize, f64)> = Vec::new();
     for (r, row) in rows.iter().enumerate() {
-        for (c, &v) in row.iter().enumerate() {
-            j[(r, c)] = v;
-        }
+        j.extend(row.iter().enumerate().filter(|(_, v)| **v != 0.0).map(|(c, &v)| (r, c, v)));
     }
-    for (k, (_, row, w, dk)) in cands.iter().enumerate() {
+    for (k, (c, row, w, dk)) in cands.iter().enumerate() {
         if row.iter().any(|v| !v.is_finite()) {
-            return Err(format!("velocity candidate '{}' has no finite derivative here", cands[k].0.name()));
+            return Err(format!("velocity candidate '{}' has no finite derivative here", c.name()));
         }
-        for (c, &v) in row.iter().enumerate() {
-            j[(nr + k, c)] = -w * v;
-        }
-        j[(nr + k, n + k)] = w * dk;
+        j.extend(row.iter().enumerate().filter(|(_, v)| **v != 0.0).map(|(col, &v)| (nr + k, col, -w * v)));
+        j.push((nr + k, n + k, w * dk));
     }
-    let lu = j.full_piv_lu();
-    let uu = lu.U();
-    let kmin = (nr + nc).min(n + nc);
-    // Every candidate row has its own D column, so J1 has full row rank exactly when the
-    // (independent) holonomic rows and the non-holonomic rows are independent together.
-    let big = (0..kmin).map(|i| uu[(i, i)].abs()).fold(0.0, f64::max).max(1.0);
-    let rank = nr + nc;
-
-    if (0..rank).any(|i| uu[(i, i)].abs() <= RANK_TOL * RANK_TOL * big) {
+    // Sparse complete pivoting (as at position level). Every candidate row has its own D
+    // column, so J1 has full row rank exactly when the (independent) holonomic rows and the
+    // non-holonomic rows are independent together.
+    let piv = full_pivot(nr + nc, n + nc, j, RANK_TOL * RANK_TOL, 1.0)
+        .map_err(|e| format!("the velocity constraint Jacobian is not finite here ({e})"))?;
+    if piv.rank < nr + nc {
         return Err("the non-holonomic constraints are not independent of the others".into());
     }
-    let perm = lu.Q().arrays().0.to_vec();
-    let free = &perm[rank..];
+    let pivoted = piv.pivoted_cols(n + nc);
     let mut out: Vec<VelState> = Vec::new();
     let mut dropped = Vec::new();
     for (k, (c, _, _, _)) in cands.into_iter().enumerate() {
-        if free.contains(&(n + k)) {
+        if !pivoted[n + k] {
             out.push(c);
         } else {
             dropped.push(c.name());
         }
     }
-    let mut internal: Vec<usize> = free.iter().copied().filter(|&c| c < n).collect();
-    internal.sort_unstable();
-    out.extend(internal.into_iter().map(|c| VelState::Derivative(internal_state(sys, c))));
+    out.extend((0..n).filter(|&c| !pivoted[c]).map(|c| VelState::Derivative(internal_state(sys, c))));
     Ok((out, dropped))
 }
 
