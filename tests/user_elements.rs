@@ -212,3 +212,39 @@ fn a_force_proportional_to_acceleration_acts_as_added_mass() {
         assert!((y[1] - 0.5 * w * w * y[0]).abs() < 1e-6, "t = {t}: drag {} want {}", y[1], 0.5 * w * w * y[0]);
     }
 }
+
+#[test]
+fn static_equilibrium_solves_for_the_controller_state_too() {
+    // A pendulum (m = 1, CM at L = 0.5 from the hinge) held by a PI torque
+    // τ = −kp (θ − θr) − ki X with X' = θ − θr. Static equilibrium (<analysis static="true"/>)
+    // solves q, λ and X with Ẋ = 0: θ = θr and −ki X = m g L sin θr, so X = −m g L sin θr / ki
+    // (closed form; Newton converges to the assembly tolerance, 1e-9 asserted).
+    let xml = r#"<multibody name="held" version="1">
+      <parameter name="th_r" value="0.3"/>
+      <parameter name="kp" value="20"/>
+      <parameter name="ki" value="5"/>
+      <gravity value="0 0 -9.81"/>
+      <ground><marker name="O" position="0 0 0" z_axis="0 1 0" x_axis="0 0 -1"/></ground>
+      <body name="bob" mass="1" inertia="0.05 0.1 0.1" position="0 0 -0.5" z_axis="0 1 0" x_axis="0 0 -1">
+        <marker name="P" position="-0.5 0 0"/>
+      </body>
+      <joint name="hinge" type="revolute" i="bob.P" j="ground.O"/>
+      <variable name="err" function="az(bob.P, ground.O) - th_r"/>
+      <differential name="xi" start="0" function="err"/>
+      <sforce name="motor" type="rotational" i="bob.P" j="ground.O" function="-kp*err - ki*xi"/>
+      <output name="angle" function="az(bob.P, ground.O)"/>
+      <output name="xi_out" function="xi"/>
+      <analysis static="true"/>
+    </multibody>"#;
+    let m = load_str(xml, "held.xml").unwrap();
+    let sim = Simulator::new(&m, SimOptions { tol: 1e-10, max_step: None }, 0.0).unwrap();
+    let mut sim = sim;
+    let y = sim.outputs().unwrap();
+    let want_x = -1.0 * 9.81 * 0.5 * 0.3f64.sin() / 5.0;
+    assert!((y[0] - 0.3).abs() < 1e-9, "angle {}", y[0]);
+    assert!((y[1] - want_x).abs() < 1e-9, "xi {} want {want_x}", y[1]);
+    // And it stays there.
+    sim.advance(1.0).unwrap();
+    let y = sim.outputs().unwrap();
+    assert!((y[0] - 0.3).abs() < 1e-8 && (y[1] - want_x).abs() < 1e-8, "{y:?}");
+}
