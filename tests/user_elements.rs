@@ -240,7 +240,7 @@ fn static_equilibrium_solves_for_the_controller_state_too() {
     let sim = Simulator::new(&m, SimOptions { tol: 1e-10, max_step: None }, 0.0).unwrap();
     let mut sim = sim;
     let y = sim.outputs().unwrap();
-    let want_x = -1.0 * 9.81 * 0.5 * 0.3f64.sin() / 5.0;
+    let want_x = -9.81 * 0.5 * 0.3f64.sin() / 5.0; // m = 1
     assert!((y[0] - 0.3).abs() < 1e-9, "angle {}", y[0]);
     assert!((y[1] - want_x).abs() < 1e-9, "xi {} want {want_x}", y[1]);
     // And it stays there.
