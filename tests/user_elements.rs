@@ -192,12 +192,23 @@ const ADDED_MASS: &str = r#"<multibody name="added_mass" version="1">
 
 #[test]
 fn a_force_proportional_to_acceleration_acts_as_added_mass() {
-    // F = −m_a ẍ (through a variable): (m + m_a) ẍ = −k x, ω = sqrt(k / (m + m_a)) = 4.4721.
+    // F = −m_a ẍ (through a variable): (m + m_a) ẍ = −k x, ω = sqrt(k / (m + m_a)).
     // Linearization: eigenvalues ±iω to 1e-9 relative (exact). Simulation from x0 = 0.1 at
     // rest: x = x0 cos ωt to 1e-7 over 2 s (tol 1e-10; global error ≈ 100·tol), and the
     // drag output equals m_a ω² x (1e-6).
-    let m = load_str(ADDED_MASS, "added_mass.xml").unwrap();
-    let w = (50.0f64 / 2.5).sqrt();
+    added_mass_case(0.5);
+    // An added mass larger than the body's (loop gain 2.5): the initial algebraic loop is
+    // solved by Newton, not by fixed point.
+    added_mass_case(5.0);
+}
+
+fn added_mass_case(ma: f64) {
+    let m = load_str(
+        &ADDED_MASS.replace(r#"value="0.5" description="added"#, &format!(r#"value="{ma}" description="added"#)),
+        "added_mass.xml",
+    )
+    .unwrap();
+    let w = (50.0f64 / (2.0 + ma)).sqrt();
     let lin = lin_at_start(&m);
     let rows = eigen_table(&lin.a).unwrap();
     assert_eq!(rows.len(), 1, "{rows:?}");
@@ -209,7 +220,7 @@ fn a_force_proportional_to_acceleration_acts_as_added_mass() {
         let y = sim.outputs().unwrap();
         let x = 0.1 * (w * t).cos();
         assert!((y[0] - x).abs() < 1e-7, "t = {t}: x = {} want {x}", y[0]);
-        assert!((y[1] - 0.5 * w * w * y[0]).abs() < 1e-6, "t = {t}: drag {} want {}", y[1], 0.5 * w * w * y[0]);
+        assert!((y[1] - ma * w * w * y[0]).abs() < 1e-6, "t = {t}: drag {} want {}", y[1], ma * w * w * y[0]);
     }
 }
 

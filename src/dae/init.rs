@@ -390,9 +390,10 @@ pub fn user_unknowns(
 }
 
 /// User unknowns, accelerations and multipliers at the initial point. When forces or user
-/// rows read element loads (an algebraic loop through the constraint forces), the loads
-/// depend on λ and λ on the forces: fixed-point iteration on λ (the integrator then solves
-/// the loop simultaneously, by Newton with the exact Jacobian).
+/// rows read element loads or accelerations (algebraic loops through the constraint
+/// forces or the inertia), they are solved together by Newton with the exact Jacobian of
+/// the equations of motion: unknowns (u̇, Ẋ, V, a, λ, ν), equations the force balance,
+/// the user rows, and the acceleration constraints P u̇ + γ = 0, B u̇ + γ_nh = 0.
 #[allow(clippy::too_many_arguments)]
 pub fn consistent_accelerations(
     sys: &System,
@@ -403,34 +404,133 @@ pub fn consistent_accelerations(
     z: &mut [f64],
     lu: &mut SparseLu,
 ) -> Result<(Vec<f64>, Vec<f64>), String> {
-    let mut lam: Option<Vec<f64>> = None;
+    use super::equations::{Layout, jacobian, mass_matrix, rhs};
+    user_unknowns(sys, q, u, None, t, inputs, z)?;
+    let ext0 = sys.ext(inputs, z, None, t);
+    let (udot0, lam0) = accelerations(sys, q, u, t, &ext0, lu)?;
+    if sys.load_refs.is_empty() && sys.acc_bodies.is_empty() {
+        return Ok((udot0, lam0));
+    }
+    let lay = Layout::of(sys);
+    let (n, m, mn) = (lay.n, lay.m, lay.mn);
+    let (nz0, nalg) = (lay.z() + lay.nx, lay.nz() - lay.nx);
     let a0 = 2 * sys.nx + sys.nv;
-    for _ in 0..200 {
-        user_unknowns(sys, q, u, lam.as_deref(), t, inputs, z)?;
-        let ext = sys.ext(inputs, z, lam.as_deref().map(|l| (q, u, l)), t);
-        let (udot, new) = accelerations(sys, q, u, t, &ext, lu)?;
-        if sys.load_refs.is_empty() && sys.acc_bodies.is_empty() {
-            return Ok((udot, new));
+    let mut y = vec![0.0; lay.dim()];
+    y[..n].copy_from_slice(q);
+    y[n..2 * n].copy_from_slice(u);
+    for (k, &b) in sys.acc_bodies.iter().enumerate() {
+        z[a0 + NQ * k..a0 + NQ * k + NQ].copy_from_slice(&udot0[NQ * b..NQ * b + NQ]);
+    }
+    y[lay.z()..lay.z() + lay.nz()].copy_from_slice(z);
+    y[lay.lam()..lay.lam() + m + mn].copy_from_slice(&lam0);
+    let mut udot = udot0;
+    // Unknown columns: u̇ (n), Z_alg (nalg), λ and ν (m + mn); the same order for rows:
+    // force balance (u rows of the DAE), algebraic Z rows, acceleration constraints.
+    let dim = n + nalg + m + mn;
+    let col_of = |c: usize| -> Option<usize> {
+        if (nz0..nz0 + nalg).contains(&c) {
+            Some(n + c - nz0)
+        } else if (lay.lam()..lay.lam() + m + mn).contains(&c) {
+            Some(n + nalg + c - lay.lam())
+        } else {
+            None
         }
-        // Accelerations read by forces: the unknowns a follow u̇ (fixed point with λ).
-        let mut change_a = 0.0f64;
-        for (k, &b) in sys.acc_bodies.iter().enumerate() {
-            for c in 0..NQ {
-                let (old, v) = (z[a0 + NQ * k + c], udot[NQ * b + c]);
-                change_a = change_a.max((old - v).abs() / (1.0 + v.abs()));
-                z[a0 + NQ * k + c] = v;
+    };
+    let row_of = |r: usize| -> Option<usize> {
+        if (n..2 * n).contains(&r) {
+            Some(r - n)
+        } else if (nz0..nz0 + nalg).contains(&r) {
+            Some(n + r - nz0)
+        } else {
+            None
+        }
+    };
+    let mut mass = Triplets::new();
+    mass_matrix(sys, lay, &mut mass);
+    let mut nlu = SparseLu::new();
+    let mut f = vec![0.0; lay.dim()];
+    let scale = 1.0 + udot.iter().chain(&y[lay.lam()..lay.lam() + m + mn]).fold(0.0f64, |a, v| a.max(v.abs()));
+    for _ in 0..50 {
+        rhs(sys, lay, t, &y, inputs, &mut f);
+        let ext = lay.ext(sys, inputs, &y, t);
+        let mut r = vec![0.0; dim];
+        let mut k = Triplets::new();
+        // Force balance: M_dae u̇ − f_u = 0.
+        for i in 0..n {
+            r[i] = -f[n + i];
+        }
+        for (p, &v) in mass.idx.iter().zip(&mass.vals) {
+            if (n..2 * n).contains(&p.row) {
+                r[p.row - n] += v * udot[p.col - n];
+                k.push(p.row - n, p.col - n, v);
             }
         }
-        let scale = 1.0 + new.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        let change = match (&lam, sys.load_refs.is_empty()) {
-            (_, true) => 0.0,
-            (None, false) => f64::INFINITY,
-            (Some(l), false) => l.iter().zip(&new).fold(0.0f64, |a, (x, y)| a.max((x - y).abs())),
-        };
-        if change <= 1e-13 * scale && change_a <= 1e-13 {
-            return Ok((udot, new));
+        for i in 0..nalg {
+            r[n + i] = f[nz0 + i];
         }
-        lam = Some(new);
+        let mut jt = Triplets::new();
+        jacobian(sys, lay, t, &y, inputs, &mut jt);
+        for (p, &v) in jt.idx.iter().zip(&jt.vals) {
+            if let (Some(rr), Some(cc)) = (row_of(p.row), col_of(p.col)) {
+                k.push(rr, cc, if rr < n { -v } else { v });
+            }
+        }
+        // Acceleration constraints (redundant rows: λ = 0).
+        let gamma = acceleration_rhs(sys, q, u, t, &ext);
+        let r0 = n + nalg;
+        for el in &sys.constraints {
+            let fc = constraint_first(sys, el, q, t, &ext);
+            let nql = NQ * el.bodies.len();
+            for e in 0..el.neq {
+                let row = el.row + e;
+                if sys.redundant[row] {
+                    k.push(r0 + row, r0 + row, 1.0);
+                    r[r0 + row] = y[lay.lam() + row];
+                    continue;
+                }
+                let pr = p_row(&el.bodies, q, &fc.cq[e * nql..(e + 1) * nql]);
+                let mut v = gamma[row];
+                for (a, pa) in pr.iter().enumerate() {
+                    let g = NQ * el.bodies[a / NQ] + a % NQ;
+                    k.push(r0 + row, g, *pa);
+                    v += pa * udot[g];
+                }
+                r[r0 + row] = v;
+            }
+        }
+        let (b, _) = nonholonomic_b(sys, q, u, t, &ext);
+        let gnh = nonholonomic_gamma(sys, q, u, t, &ext);
+        for (row, gv) in gnh.iter().enumerate() {
+            r[r0 + m + row] = *gv;
+        }
+        for (row, c, v) in b {
+            k.push(r0 + m + row, c, v);
+            r[r0 + m + row] += v * udot[c];
+        }
+        let worst = r.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        if !worst.is_finite() {
+            return Err(
+                "the algebraic loop through element loads or accelerations is not finite at the initial state".into()
+            );
+        }
+        if worst <= 1e-12 * scale {
+            z.copy_from_slice(&y[lay.z()..lay.z() + lay.nz()]);
+            return Ok((udot, y[lay.lam()..lay.lam() + m + mn].to_vec()));
+        }
+        nlu.factor(dim, &k).map_err(|e| format!("the algebraic loop at the initial state is singular ({e})"))?;
+        r.iter_mut().for_each(|v| *v = -*v);
+        if !nlu.solve(&mut r) {
+            return Err("the algebraic loop at the initial state is singular".into());
+        }
+        for i in 0..n {
+            udot[i] += r[i];
+        }
+        for i in 0..nalg {
+            y[nz0 + i] += r[n + i];
+        }
+        for i in 0..m + mn {
+            y[lay.lam() + i] += r[n + nalg + i];
+        }
     }
     Err("the algebraic loop through element loads or accelerations does not converge at the initial state".into())
 }
