@@ -465,9 +465,7 @@ pub fn consistent_accelerations(
                 k.push(p.row - n, p.col - n, v);
             }
         }
-        for i in 0..nalg {
-            r[n + i] = f[nz0 + i];
-        }
+        r[n..n + nalg].copy_from_slice(&f[nz0..nz0 + nalg]);
         let mut jt = Triplets::new();
         jacobian(sys, lay, t, &y, inputs, &mut jt);
         for (p, &v) in jt.idx.iter().zip(&jt.vals) {
