@@ -112,3 +112,52 @@ fn rolling_disc_keeps_its_constraints_and_energy_over_ten_seconds() {
     // Small-amplitude lean: amplitude ≈ lean_rate0 / ω, ω = sqrt(0.8 (300 − g/r)) = 14.62.
     assert!((lean_max - 0.3 / 14.6233).abs() < 0.1 * 0.3 / 14.6233, "lean amplitude {lean_max}");
 }
+
+#[test]
+fn static_equilibrium_with_a_knife_edge_across_a_slope() {
+    // A sled on a 20° slope (planar joint) with its blade horizontal, across the fall line,
+    // and its CM on the blade; springs (relaxed) hold it along the blade and in heading
+    // (else the static problem is singular: neutral directions). The knife edge (multiplier
+    // ν = m g sin α) holds it across: static equilibrium solves q, λ and ν, keeping the
+    // sled where it was assembled; released, it stays (|Δr| < 1e-9 after 1 s). Without the
+    // knife it slides down the fall line (checked against g sin α t²/2 along the slope).
+    let with_knife = r#"<multibody name="sled" version="1">
+      <parameter name="al" value="20*pi/180"/>
+      <gravity value="0 0 -9.81"/>
+      <ground>
+        <marker name="slope" position="0 0 0" z_axis="0, -sin(al), cos(al)" x_axis="1 0 0"/>
+        <marker name="anchor" position="-0.5 0 0"/>
+      </ground>
+      <body name="s" mass="3" inertia="0.2 0.3 0.4" position="0.5 0 0" z_axis="0, -sin(al), cos(al)" x_axis="1 0 0"/>
+      <joint name="plane" type="planar" i="s.cm" j="ground.slope"/>
+      <knife_edge name="blade" marker="s.cm"/>
+      <spring_damper name="along" type="translational" i="s.cm" j="ground.anchor" stiffness="50" damping="1" length="1"/>
+      <spring_damper name="turn" type="rotational" i="s.cm" j="ground.slope" stiffness="5" damping="0.1"/>
+      <output name="x" function="dx(s.cm)"/>
+      <output name="y" function="dy(s.cm)"/>
+      <analysis static="true"/>
+    </multibody>"#;
+    let m = load_str_model(with_knife);
+    let mut sim = Simulator::new(&m, SimOptions { tol: 1e-10, max_step: None }, 0.0).unwrap();
+    let y0 = sim.outputs().unwrap();
+    assert!((y0[0] - 0.5).abs() < 1e-9 && y0[1].abs() < 1e-9, "moved while solving: {y0:?}");
+    sim.advance(1.0).unwrap();
+    let y1 = sim.outputs().unwrap();
+    assert!((y1[0] - y0[0]).abs() < 1e-9 && (y1[1] - y0[1]).abs() < 1e-9, "{y0:?} -> {y1:?}");
+    // Without the blade (and springs) the sled slides down the fall line: after 1 s it has
+    // moved g sin α / 2 along the slope, i.e. g sin α cos α / 2 in ground −y.
+    let free = with_knife
+        .replace(r#"<knife_edge name="blade" marker="s.cm"/>"#, "")
+        .replace(r#"<analysis static="true"/>"#, "")
+        .replace(r#"stiffness="50" damping="1""#, r#"stiffness="0" damping="0""#)
+        .replace(r#"stiffness="5" damping="0.1""#, r#"stiffness="0" damping="0""#);
+    let mut sim = Simulator::new(&load_str_model(&free), SimOptions { tol: 1e-10, max_step: None }, 0.0).unwrap();
+    sim.advance(1.0).unwrap();
+    let slid = -sim.outputs().unwrap()[1];
+    let want = 0.5 * 9.81 * (20f64.to_radians()).sin() * (20f64.to_radians()).cos();
+    assert!((slid - want).abs() < 1e-6, "slid {slid} want {want}");
+}
+
+fn load_str_model(xml: &str) -> Model {
+    mbfmu::model::parse::load_str(xml, "sled.xml").unwrap()
+}

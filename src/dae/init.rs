@@ -298,19 +298,30 @@ pub fn static_equilibrium(
     let ext = lay.ext(sys, inputs, &y, t);
     let (_, lam0) = accelerations(sys, q, &vec![0.0; n], t, &ext, &mut lu)?;
     y[nl..nl + m].copy_from_slice(&lam0[..m]);
-    // Equations: u rows, user rows, C rows; unknowns: q, X, V, λ (Ẋ = 0 held).
+    // Equations: u rows, user rows, C rows; unknowns: q, X, V, a, λ, ν (Ẋ = 0 held). At
+    // rest the non-holonomic constraints hold trivially and their multipliers ν carry loads
+    // (e.g. a knife edge across a slope); the positions they leave free to drift are held
+    // by mn extra rows B T (q − q0) = 0 (no motion along the constrained directions).
+    let mn = sys.mn;
+    let q0 = q.to_vec();
+    let mut bt = vec![vec![0.0; n]; mn];
+    for (r, c, v) in nonholonomic_b(sys, q, &vec![0.0; n], t, &ext).0 {
+        bt[r][c] += v;
+    }
+    bt.iter_mut().for_each(|row| crate::mechanics::body::row_times_t(q, row));
     let rows: Vec<usize> = (n..2 * n).chain(nz + nx..nz + lay.nz()).chain(nl..nl + m).collect();
-    let cols: Vec<usize> = (0..n).chain(nz..nz + nx).chain(nz + 2 * nx..nz + lay.nz()).chain(nl..nl + m).collect();
+    let cols: Vec<usize> = (0..n).chain(nz..nz + nx).chain(nz + 2 * nx..nz + lay.nz()).chain(nl..nl + m + mn).collect();
     let mut row_of = vec![usize::MAX; lay.dim()];
     let mut col_of = vec![usize::MAX; lay.dim()];
     rows.iter().enumerate().for_each(|(k, &r)| row_of[r] = k);
     cols.iter().enumerate().for_each(|(k, &c)| col_of[c] = k);
-    let dim = rows.len();
+    let dim = rows.len() + mn;
     let mut f = vec![0.0; lay.dim()];
     let scale = 1.0 + sys.bodies.iter().map(|b| b.mass).sum::<f64>() * sys.gravity.iter().map(|g| g.abs()).sum::<f64>();
     for _ in 0..100 {
         rhs(sys, lay, t, &y, inputs, &mut f);
         let mut r: Vec<f64> = rows.iter().map(|&i| f[i]).collect();
+        r.extend(bt.iter().map(|row| row.iter().zip(y.iter().zip(&q0)).map(|(b, (x, x0))| b * (x - x0)).sum::<f64>()));
         let worst = r.iter().fold(0.0f64, |a, v| a.max(v.abs()));
         if !worst.is_finite() {
             return Err("static equilibrium: the equations are not finite".into());
@@ -327,6 +338,11 @@ pub fn static_equilibrium(
             let (rr, cc) = (row_of[p.row], col_of[p.col]);
             if rr != usize::MAX && cc != usize::MAX {
                 k.push(rr, cc, v);
+            }
+        }
+        for (i, row) in bt.iter().enumerate() {
+            for (c, &v) in row.iter().enumerate().filter(|(_, v)| **v != 0.0) {
+                k.push(rows.len() + i, c, v);
             }
         }
         lu.factor(dim, &k).map_err(|e| format!("static equilibrium: singular equations ({e})"))?;

@@ -11,26 +11,13 @@ use super::states::{StateFn, VelState, internal_state, user_states, user_velocit
 use crate::dae::equations::nonholonomic_b;
 use crate::dae::rank::full_pivot;
 use crate::mechanics::System;
-use crate::mechanics::body::NQ;
+use crate::mechanics::body::{NQ, row_times_t};
 use crate::mechanics::kernels::constraint_first;
 
 /// Preference of explicit `<velocity>` candidates over derivatives of user position states:
 /// their rows weigh this much more and their D entries this much less, so full pivoting
 /// eliminates them first and, between two dependent candidates, pivots (drops) the other.
 const VELOCITY_PREFERENCE: f64 = 10.0;
-
-/// Row `r` (u-space, global) times T(q): the same row in q̇-space (T = H⁻¹ per body).
-fn times_t(q: &[f64], r: &mut [f64]) {
-    for b in 0..q.len() / NQ {
-        let o = NQ * b;
-        let (st, ct, sp, cp) = (q[o + 4].sin(), q[o + 4].cos(), q[o + 5].sin(), q[o + 5].cos());
-        let t = [[st * sp, cp, 0.0], [st * cp, -sp, 0.0], [ct, 0.0, 1.0]];
-        let w = [r[o + 3], r[o + 4], r[o + 5]];
-        for c in 0..3 {
-            r[o + 3 + c] = (0..3).map(|k| w[k] * t[k][c]).sum();
-        }
-    }
-}
 
 /// Choose the velocity states W at (q, u, t) given the position selection `states`.
 pub fn select_velocities(
@@ -51,7 +38,7 @@ pub fn select_velocities(
         for a in 0..nql {
             row[NQ * v.bodies[a / NQ] + a % NQ] = j.dg[nql + a];
         }
-        times_t(q, &mut row);
+        row_times_t(q, &mut row);
         cands.push((VelState::User(v), row, USER_ROW_WEIGHT * VELOCITY_PREFERENCE, D_SMALL / VELOCITY_PREFERENCE));
     }
     for s in user_states(sys) {
@@ -86,7 +73,7 @@ pub fn select_velocities(
         brows[r][c] += v;
     }
     for mut row in brows {
-        times_t(q, &mut row);
+        row_times_t(q, &mut row);
         rows.push(row);
     }
     let nr = rows.len();

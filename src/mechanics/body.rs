@@ -34,3 +34,17 @@ pub fn h_transpose_times<T: Real>(q: &[T], w: &[T]) -> [T; NQ] {
     let e = h_angular(q[4], q[5]).tv(&V3([w[3], w[4], w[5]]));
     [w[0], w[1], w[2], e.0[0], e.0[1], e.0[2]]
 }
+
+/// A u-space row `r` (global, 6 per body) times T(q), with u = T(q) q̇: the same linear
+/// form in q̇ (T = H⁻¹ per body; T_angular maps 3-1-3 rates to body-axis ω').
+pub fn row_times_t(q: &[f64], r: &mut [f64]) {
+    for b in 0..q.len() / NQ {
+        let o = NQ * b;
+        let (st, ct, sp, cp) = (q[o + 4].sin(), q[o + 4].cos(), q[o + 5].sin(), q[o + 5].cos());
+        let t = [[st * sp, cp, 0.0], [st * cp, -sp, 0.0], [ct, 0.0, 1.0]];
+        let w = [r[o + 3], r[o + 4], r[o + 5]];
+        for c in 0..3 {
+            r[o + 3 + c] = (0..3).map(|k| w[k] * t[k][c]).sum();
+        }
+    }
+}
