@@ -128,3 +128,21 @@ def test_user_elements_and_nonholonomic_fmus_give_the_cli_matrices(packed, model
     assert all(math.isfinite(v) for v in s.getReal([p.vr[n] for n in states + derivs]))
     s.terminate()
     s.freeInstance()
+
+
+def test_benchmark_bicycle_eigenvalues_through_the_fmu(packed):
+    # Meijaard et al. (2007) benchmark at v = 5 m/s: the published lean/steer eigenvalues
+    # -14.0783897, -0.3228664, -0.7753419 +- 4.4648677i (7 digits printed in the paper's
+    # Table 2 style; 1e-6 relative) among the FMU's A from fmi2GetDirectionalDerivative,
+    # the other six zero (s0 = 7 position, s1 = 3 velocity states).
+    p = packed("benchmark_bicycle")
+    s = new_slave(p)
+    initialize(s, tol=1e-10)
+    states, derivs = state_names(p)
+    assert len(states) == 10
+    ev = np.linalg.eigvals(jacobian(s, p, derivs, states))
+    for want in (-14.0783897, -0.3228664, complex(-0.7753419, 4.4648677), complex(-0.7753419, -4.4648677)):
+        assert np.min(np.abs(ev - want)) < 1e-6 * abs(want), (want, ev)
+    assert np.sum(np.abs(ev) < 1e-5) == 6, ev
+    s.terminate()
+    s.freeInstance()
