@@ -179,46 +179,21 @@ pub fn variables(model: &Model) -> Vec<Variable> {
     }
     let first_x = v.len();
     for (k, d) in model.differentials.iter().enumerate() {
-        v.push(Variable {
-            name: d.name.clone(),
-            value_reference: v.len() as u32,
-            causality: Causality::Local,
-            target: Target::Diff(k),
-            start: None,
-            unit: None,
-            description: Some("differential state (seed Eq. 7a)".into()),
-            derivative: None,
-            known: Some(s0 + s1 + k),
-            unknown: None,
-        });
+        let mut x = var(d.name.clone(), v.len(), Target::Diff(k));
+        x.description = Some("differential state (seed Eq. 7a)".into());
+        x.known = Some(s0 + s1 + k);
+        v.push(x);
     }
     for (k, d) in model.differentials.iter().enumerate() {
-        v.push(Variable {
-            name: format!("der({})", d.name),
-            value_reference: v.len() as u32,
-            causality: Causality::Local,
-            target: Target::DiffDerivative(k),
-            start: None,
-            unit: None,
-            description: None,
-            derivative: Some(first_x + k + 1),
-            known: None,
-            unknown: Some(s0 + s1 + k),
-        });
+        let mut x = var(format!("der({})", d.name), v.len(), Target::DiffDerivative(k));
+        x.derivative = Some(first_x + k + 1);
+        x.unknown = Some(s0 + s1 + k);
+        v.push(x);
     }
     for (k, d) in model.variables.iter().enumerate() {
-        v.push(Variable {
-            name: d.name.clone(),
-            value_reference: v.len() as u32,
-            causality: Causality::Local,
-            target: Target::UserVariable(k),
-            start: None,
-            unit: None,
-            description: Some("user variable (seed Eq. 7b)".into()),
-            derivative: None,
-            known: None,
-            unknown: None,
-        });
+        let mut x = var(d.name.clone(), v.len(), Target::UserVariable(k));
+        x.description = Some("user variable (seed Eq. 7b)".into());
+        v.push(x);
     }
     v
 }
