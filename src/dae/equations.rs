@@ -14,7 +14,7 @@ use crate::mechanics::kernels::{
     constraint_first, constraint_second, dhtw_dq, dqdot_dq, force_ext_jacobian, force_jacobian, force_values, gather,
     gyroscopic, nonholonomic_second, user_jacobian, user_residual,
 };
-use crate::mechanics::loads::{LoadGradient, NLOAD, load_gradient};
+use crate::mechanics::loads::{LoadGradient, LoadTerm, NLOAD, load_gradient};
 
 /// Index layout of y.
 #[derive(Clone, Copy, Debug)]
@@ -487,7 +487,6 @@ pub fn nonholonomic_b(sys: &System, q: &[f64], u: &[f64], t: f64, ext: &[f64]) -
 struct LoadChain {
     lay: Layout,
     ni: usize,
-    base_len: usize,
     grads: Vec<Option<LoadGradient>>,
 }
 
@@ -497,31 +496,23 @@ impl LoadChain {
         let base = &ext[..ni + lay.nz()];
         let state = (&y[..n], &y[n..2 * n], &y[lay.lam()..lay.lam() + lay.m]);
         let grads = sys.load_refs.iter().map(|&r| load_gradient(sys, r, state, t, base)).collect();
-        LoadChain { lay, ni, base_len: base.len(), grads }
+        LoadChain { lay, ni, grads }
     }
 
     /// Add coeff · ∂L_e/∂(unknowns) to row `row` (e: external-value index of a load).
     fn push(&self, jac: &mut Triplets, row: usize, e: usize, coeff: f64) {
         let lay = self.lay;
         let k = e - self.ni - lay.nz();
-        let (slot, c) = (k / NLOAD, k % NLOAD);
-        let Some(g) = &self.grads[slot] else { return };
-        let nlb = NQ * g.bodies.len();
-        for a in 0..nlb {
-            let gl = glob(&g.bodies, a);
-            jac.push(row, gl, coeff * g.dz[c * 2 * nlb + a]);
-            jac.push(row, lay.u() + gl, coeff * g.dz[c * 2 * nlb + nlb + a]);
-        }
-        let neq = g.neq();
-        for kk in 0..neq {
-            jac.push(row, lay.lam() + g.lam_row + kk, coeff * g.dlam[c * neq + kk]);
-        }
-        for z in 0..lay.nz() {
-            let d = g.dv.get(c * self.base_len + self.ni + z).copied().unwrap_or(0.0);
-            if d != 0.0 {
-                jac.push(row, lay.z() + z, coeff * d);
+        let Some(g) = &self.grads[k / NLOAD] else { return };
+        g.terms(k % NLOAD, |term, d| match term {
+            LoadTerm::Q(i) => jac.push(row, i, coeff * d),
+            LoadTerm::U(i) => jac.push(row, lay.u() + i, coeff * d),
+            LoadTerm::Lam(r) => jac.push(row, lay.lam() + r, coeff * d),
+            LoadTerm::Ext(x) if x >= self.ni && x < self.ni + lay.nz() => {
+                jac.push(row, lay.z() + x - self.ni, coeff * d)
             }
-        }
+            LoadTerm::Ext(_) => {}
+        });
     }
 }
 

@@ -14,7 +14,7 @@ use crate::dae::sparse::{SparseLu, Triplets};
 use crate::dae::{EngineError, Simulator};
 use crate::mechanics::body::NQ;
 use crate::mechanics::kernels::{force_ext_jacobian, user_jacobian};
-use crate::mechanics::loads::{LoadGradient, NLOAD, load_gradient};
+use crate::mechanics::loads::{LoadGradient, LoadTerm, NLOAD, load_gradient};
 use faer::Mat;
 
 /// A, B, C, D at one operating point, with the names of states, inputs and outputs.
@@ -386,20 +386,17 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
         }
         for (li, &dy) in g.dv[ni + nz..].iter().enumerate() {
             let Some(lg) = lgrads[li / NLOAD].as_ref().filter(|_| dy != 0.0) else { continue };
-            let (c, nlb, neq) = (li % NLOAD, NQ * lg.bodies.len(), lg.neq());
-            for a in 0..nlb {
-                let gi = NQ * lg.bodies[a / NQ] + a % NQ;
-                if kinematic {
-                    v += dy * lg.dz[c * 2 * nlb + a] * x[bl.q() + gi];
-                    v += dy * lg.dz[c * 2 * nlb + nlb + a] * x[bl.u() + gi];
-                }
-            }
-            for k in 0..neq {
-                v += dy * lg.dlam[c * neq + k] * x[bl.lam() + lg.lam_row + k];
-            }
-            for zi in 0..nz {
-                v += dy * lg.dv.get(c * (ni + nz) + ni + zi).copied().unwrap_or(0.0) * x[bl.z() + zi];
-            }
+            lg.terms(li % NLOAD, |term, d| {
+                v += dy
+                    * d
+                    * match term {
+                        LoadTerm::Q(i) if kinematic => x[bl.q() + i],
+                        LoadTerm::U(i) if kinematic => x[bl.u() + i],
+                        LoadTerm::Lam(r) => x[bl.lam() + r],
+                        LoadTerm::Ext(e) if e >= ni && e < ni + nz => x[bl.z() + e - ni],
+                        _ => 0.0,
+                    }
+            });
         }
         v
     };

@@ -9,7 +9,7 @@ use crate::ad::{Dual, Real};
 use crate::mechanics::System;
 use crate::mechanics::body::NQ;
 use crate::mechanics::kernels::gather;
-use crate::mechanics::loads::{NLOAD, load_gradient, load_index, load_value};
+use crate::mechanics::loads::{LoadTerm, NLOAD, load_gradient, load_index, load_value};
 use crate::mechanics::local::LocalCtx;
 use crate::model::expr::{ElementRef, Expr, LoadFn, deps};
 
@@ -94,20 +94,15 @@ pub fn output_gradient(sys: &System, e: &Expr, abase: usize, p: Point) -> Output
             continue;
         };
         let dy = load_sensitivity(sys, e, abase, &own, p, &value_of, r);
-        let (nlb, neq, ni) = (NQ * g.bodies.len(), g.neq(), p.inputs.len());
+        let local = |i: usize| NQ * slot(i / NQ) + i % NQ;
         for (c, &w) in dy.iter().enumerate().filter(|(_, w)| **w != 0.0) {
             // Chain rule: dy = Σ_c ∂y/∂load_c (∂load_c/∂q dq + ∂load_c/∂u du + ∂load_c/∂λ dλ + ∂load_c/∂v dv).
-            for a in 0..nlb {
-                let s = NQ * slot(g.bodies[a / NQ]) + a % NQ;
-                dz[s] += w * g.dz[c * 2 * nlb + a];
-                dz[nql + s] += w * g.dz[c * 2 * nlb + nlb + a];
-            }
-            for k in 0..neq {
-                dlam.push((g.lam_row + k, w * g.dlam[c * neq + k]));
-            }
-            for (k, x) in dv.iter_mut().enumerate() {
-                *x += w * g.dv[c * ni + k];
-            }
+            g.terms(c, |term, d| match term {
+                LoadTerm::Q(i) => dz[local(i)] += w * d,
+                LoadTerm::U(i) => dz[nql + local(i)] += w * d,
+                LoadTerm::Lam(r) => dlam.push((r, w * d)),
+                LoadTerm::Ext(k) => dv[k] += w * d,
+            });
         }
     }
     OutputGradient { bodies, dz, dlam, dv }

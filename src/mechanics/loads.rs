@@ -54,10 +54,45 @@ pub struct LoadGradient {
     pub dv: Vec<f64>,
 }
 
+/// What one entry of a load's gradient is a derivative with respect to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LoadTerm {
+    /// Global coordinate q_i.
+    Q(usize),
+    /// Global velocity u_i.
+    U(usize),
+    /// Global multiplier row λ_r.
+    Lam(usize),
+    /// External value k (index into the values the gradient was evaluated with).
+    Ext(usize),
+}
+
 impl LoadGradient {
     /// Number of multiplier columns of `dlam`.
     pub fn neq(&self) -> usize {
         self.dlam.len() / NLOAD
+    }
+
+    /// Every nonzero partial derivative of load component `c`, as (what, value): the
+    /// chain rule of anything that reads this load walks these.
+    pub fn terms(&self, c: usize, mut f: impl FnMut(LoadTerm, f64)) {
+        let nlb = NQ * self.bodies.len();
+        for a in 0..nlb {
+            let g = NQ * self.bodies[a / NQ] + a % NQ;
+            f(LoadTerm::Q(g), self.dz[c * 2 * nlb + a]);
+            f(LoadTerm::U(g), self.dz[c * 2 * nlb + nlb + a]);
+        }
+        let neq = self.neq();
+        for k in 0..neq {
+            f(LoadTerm::Lam(self.lam_row + k), self.dlam[c * neq + k]);
+        }
+        let next = self.dv.len() / NLOAD;
+        for k in 0..next {
+            let d = self.dv[c * next + k];
+            if d != 0.0 {
+                f(LoadTerm::Ext(k), d);
+            }
+        }
     }
 }
 
