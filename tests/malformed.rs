@@ -340,3 +340,9 @@ case!(
     "57_state_name_clash.xml",
     "57_state_name_clash.xml:5:12: state 'height': name 'height' is already an FMI variable (line 3)"
 );
+
+case!(
+    m58_load_of_user_constraint,
+    "58_load_of_user_constraint.xml",
+    "58_load_of_user_constraint.xml:4:27: output 'reaction': 'function' reads the load of a user constraint, which has no load"
+);

@@ -294,12 +294,10 @@ impl System {
             load_refs.sort_unstable_by_key(|r| format!("{r:?}"));
             load_refs.dedup();
         }
+        // (Loads of user constraints are refused by the parser: they have none.)
         for r in &load_refs {
             let reads_loads = |es: Vec<&Expr>| es.iter().any(|e| !deps(e).loads.is_empty());
             let bad = match *r {
-                ElementRef::Constraint(k) => {
-                    Some(format!("user constraint '{}' has no load", model.constraints[k].name))
-                }
                 ElementRef::Sforce(k) if reads_loads(vec![&model.sforces[k].function]) => {
                     Some(format!("sforce '{}' reads loads itself", model.sforces[k].name))
                 }

@@ -2,7 +2,7 @@
 
 use super::attrs::El;
 use crate::model::ModelError;
-use crate::model::expr::{self, Expr};
+use crate::model::expr::{self, ElementRef, Expr};
 
 /// A mass must be positive.
 pub(crate) fn check_mass(m: f64) -> Result<(), String> {
@@ -51,10 +51,11 @@ pub(crate) enum Allowed {
 pub(crate) fn check_deps(el: &El, attr: &str, e: &Expr, allowed: Allowed) -> Result<(), ModelError> {
     let d = expr::deps(e);
     let at = el.get(attr).map_or(el.x.pos, |a| a.pos);
-    if allowed == Allowed::Force {
-        return Ok(());
-    }
-    if allowed == Allowed::Any {
+    if matches!(allowed, Allowed::Force | Allowed::Any) {
+        // A user constraint has no markers, hence no load to read.
+        if d.loads.iter().any(|r| matches!(r, ElementRef::Constraint(_))) {
+            return Err(el.err_at(at, format!("'{attr}' reads the load of a user constraint, which has no load")));
+        }
         return Ok(());
     }
     let max_level = if allowed == Allowed::Velocities { 1 } else { 0 };
