@@ -1,0 +1,402 @@
+"""One FMU instance driven through time: open (zip or directory), instantiate with a
+logger whose messages go into errors, initialize with start values and fmpy-style input
+signals, advance to a time (Co-Simulation: doStep; Model Exchange: CVode with events),
+and read values and directional derivatives at the current point.
+
+Failed FMI calls become FMUCallError naming the function, the time and the FMU's last
+log messages; the instance is freed by `close()` (or the context manager) in every case.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import itertools
+import math
+import os
+import shutil
+import threading
+from pathlib import Path
+
+import numpy as np
+from fmpy import extract, read_model_description
+from fmpy.fmi2 import (
+    FMU2Model,
+    FMU2Slave,
+    fmi2CallbackAllocateMemoryTYPE,
+    fmi2CallbackFreeMemoryTYPE,
+    fmi2CallbackFunctions,
+    fmi2CallbackLoggerTYPE,
+)
+
+from .errors import ArgumentError, FMUCallError, FMUNotFoundError, MbfmuError
+
+# --- log capture --------------------------------------------------------------------
+# fmpy's native proxy (fmpy.logging.addLoggerProxy) formats the variadic message and calls
+# one Python function; that function is process-wide, so one dispatcher routes messages
+# to the instance they name.
+_LOGS: dict[str, list[str]] = {}
+_LOG_LOCK = threading.Lock()
+_NAMES = itertools.count()
+_STATUS = ["OK", "Warning", "Discard", "Error", "Fatal", "Pending"]
+
+
+def _dispatch(env, name, status, category, message):
+    key = name.decode("utf-8", "replace") if name else ""
+    text = message.decode("utf-8", "replace") if message else ""
+    cat = category.decode("utf-8", "replace") if category else ""
+    with _LOG_LOCK:
+        log = _LOGS.get(key)
+        if log is not None:
+            log.append(f"[{_STATUS[status] if 0 <= status < len(_STATUS) else status}] {cat}: {text}")
+            del log[:-50]
+
+
+_DISPATCH = fmi2CallbackLoggerTYPE(_dispatch)
+_libc = ctypes.CDLL(None)
+_calloc = fmi2CallbackAllocateMemoryTYPE(("calloc", _libc))
+_free = fmi2CallbackFreeMemoryTYPE(("free", _libc))
+
+
+def _callbacks() -> fmi2CallbackFunctions:
+    cb = fmi2CallbackFunctions()
+    cb.logger = _DISPATCH
+    cb.allocateMemory = _calloc
+    cb.freeMemory = _free
+    try:
+        from fmpy.logging import addLoggerProxy
+
+        addLoggerProxy(ctypes.byref(cb))
+    except Exception:  # pragma: no cover - the proxy ships with fmpy's wheels
+        pass
+    return cb
+
+
+# --- opening ------------------------------------------------------------------------
+
+
+class Opened:
+    """An FMU on disk: its unzip directory (a temporary one for a zip) and description."""
+
+    def __init__(self, path: str | os.PathLike):
+        p = Path(path)
+        if not p.exists():
+            raise FMUNotFoundError(f"FMU '{p}' does not exist")
+        self.path = p
+        self._tmp = None
+        try:
+            if p.is_dir():
+                self.unzipdir = str(p)
+            else:
+                self._tmp = extract(str(p))
+                self.unzipdir = self._tmp
+            self.md = read_model_description(self.unzipdir, validate=False)
+        except MbfmuError:
+            raise
+        except Exception as e:
+            self.close()
+            raise MbfmuError(f"FMU '{p}' cannot be read: {e}") from e
+
+    def close(self):
+        if self._tmp is not None:
+            shutil.rmtree(self._tmp, ignore_errors=True)
+            self._tmp = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+
+def choose_interface(md, interface: str | None = None) -> str:
+    """'CoSimulation' or 'ModelExchange': the requested one, else the one that provides
+    directional derivatives (Co-Simulation first), else Co-Simulation if it is all there is."""
+    have = {"CoSimulation": md.coSimulation, "ModelExchange": md.modelExchange}
+    if interface is not None:
+        if interface not in have:
+            raise ArgumentError(f"interface '{interface}': expected 'CoSimulation' or 'ModelExchange'")
+        if have[interface] is None:
+            raise ArgumentError(f"FMU '{md.modelName}' has no {interface} interface")
+        return interface
+    for kind in ("CoSimulation", "ModelExchange"):
+        if have[kind] is not None and have[kind].providesDirectionalDerivative:
+            return kind
+    # No directional derivatives: Model Exchange can be differenced legally
+    # (fmi2SetContinuousStates); Co-Simulation states cannot be set.
+    for kind in ("ModelExchange", "CoSimulation"):
+        if have[kind] is not None:
+            return kind
+    raise MbfmuError(f"FMU '{md.modelName}' has neither a Co-Simulation nor a Model Exchange interface")
+
+
+def settable_in_instantiated(v) -> bool:
+    return v.causality == "input" or (v.variability != "constant" and v.initial in {"approx", "exact"})
+
+
+def settable_in_initialization(v) -> bool:
+    return (
+        v.causality == "input"
+        or (v.causality != "parameter" and v.variability == "tunable")
+        or (v.variability != "constant" and v.initial == "exact")
+    )
+
+
+def check_start_values(md, start_values: dict) -> None:
+    """Every name must be a variable that can be given a start value."""
+    by_name = {v.name: v for v in md.modelVariables}
+    for name in start_values:
+        v = by_name.get(name)
+        if v is None:
+            import difflib
+
+            close = difflib.get_close_matches(name, list(by_name), n=3)
+            hint = f"; did you mean {', '.join(repr(c) for c in close)}?" if close else ""
+            raise ArgumentError(f"FMU '{md.modelName}' has no variable '{name}'{hint}")
+        if not (settable_in_instantiated(v) or settable_in_initialization(v)):
+            raise ArgumentError(
+                f"FMU '{md.modelName}': variable '{name}' (causality {v.causality}, variability {v.variability}, "
+                f"initial {v.initial}) cannot be given a start value"
+            )
+
+
+# --- the instance -------------------------------------------------------------------
+
+
+class Instance:
+    """An instantiated, initialized FMU interface at a current time."""
+
+    def __init__(self, unzipdir: str, md, interface: str, tolerance: float | None = None):
+        self.md = md
+        self.interface = interface
+        self.name = f"mbfmu{next(_NAMES)}"
+        with _LOG_LOCK:
+            _LOGS[self.name] = []
+        cls = FMU2Slave if interface == "CoSimulation" else FMU2Model
+        info = md.coSimulation if interface == "CoSimulation" else md.modelExchange
+        self.fmu = cls(
+            guid=md.guid, unzipDirectory=unzipdir, modelIdentifier=info.modelIdentifier, instanceName=self.name
+        )
+        self._callbacks = _callbacks()
+        self.time = math.nan
+        self.tolerance = tolerance
+        self._input = None
+        self._solver = None
+        self._next_event = math.inf
+        self._alive = False
+        self._call("fmi2Instantiate", lambda: self.fmu.instantiate(callbacks=self._callbacks, loggingOn=False))
+        self._alive = True
+
+    @classmethod
+    def attach(cls, fmu, md, time: float) -> Instance:
+        """Wrap a host's fmpy instance (already initialized, at `time`); `close()` leaves it alive."""
+        self = cls.__new__(cls)
+        self.md = md
+        self.interface = "ModelExchange" if isinstance(fmu, FMU2Model) else "CoSimulation"
+        self.name = getattr(fmu, "instanceName", "host instance")
+        self.fmu = fmu
+        self.time = self.start_time = float(time)
+        self.tolerance = None
+        self._input = None
+        self._solver = None
+        self._next_event = math.inf
+        self._alive = False  # not ours to terminate or free
+        return self
+
+    # -- errors --
+
+    def log(self) -> list[str]:
+        """The FMU's messages so far (the last 50)."""
+        with _LOG_LOCK:
+            return list(_LOGS.get(self.name, []))
+
+    def _call(self, what: str, fn, *args, **kwargs):
+        try:
+            return fn(*args, **kwargs)
+        except Exception as e:  # FMICallException and whatever a host's FMU raises
+            if isinstance(e, MbfmuError):
+                raise
+            log = self.log()
+            at = "" if math.isnan(self.time) else f" at t = {self.time:g}"
+            tail = ("; the FMU logged:\n  " + "\n  ".join(log[-8:])) if log else ""
+            raise FMUCallError(f"FMU '{self.md.modelName}': {what} failed{at}: {e}{tail}") from e
+
+    # -- set-up --
+
+    def initialize(
+        self, start_time: float, start_values: dict | None = None, inputs=None, stop_time: float | None = None
+    ) -> None:
+        """setupExperiment, start values, inputs at start_time, initialization mode."""
+        from fmpy.simulation import Input, apply_start_values
+
+        sv = dict(start_values or {})
+        check_start_values(self.md, sv)
+        fmu = self.fmu
+        cs = self.interface == "CoSimulation"
+        self.time = start_time
+        self.start_time = start_time
+        if cs:
+            self._call(
+                "fmi2SetupExperiment",
+                lambda: fmu.setupExperiment(tolerance=self.tolerance, startTime=start_time, stopTime=stop_time),
+            )
+        else:
+            self._call("fmi2SetupExperiment", lambda: fmu.setupExperiment(startTime=start_time, stopTime=stop_time))
+        sv = self._call("setting start values", lambda: apply_start_values(fmu, self.md, sv, settable_in_instantiated))
+        self._call("fmi2EnterInitializationMode", fmu.enterInitializationMode)
+        sv = self._call(
+            "setting start values", lambda: apply_start_values(fmu, self.md, sv, settable_in_initialization)
+        )
+        if sv:
+            raise ArgumentError(f"FMU '{self.md.modelName}': start values not set: {', '.join(sv)}")
+        interp = cs and bool(self.md.coSimulation.canInterpolateInputs) and inputs is not None
+        self._input = self._call("reading inputs", lambda: Input(fmu, self.md, inputs, set_input_derivatives=interp))
+        self._apply_inputs()
+        self._call("fmi2ExitInitializationMode", fmu.exitInitializationMode)
+        if not cs:
+            self._me_event_iteration()
+            self._call("fmi2EnterContinuousTimeMode", fmu.enterContinuousTimeMode)
+            self._start_solver(start_time)
+
+    def _me_event_iteration(self):
+        while True:
+            need, terminate, _, _, defined, t_next = self._call("fmi2NewDiscreteStates", self.fmu.newDiscreteStates)
+            if terminate:
+                raise FMUCallError(f"FMU '{self.md.modelName}' asked to terminate at t = {self.time:g}")
+            if not need:
+                break
+        self._next_event = t_next if defined else math.inf
+
+    def _start_solver(self, t: float):
+        from fmpy.sundials import CVodeSolver
+
+        md = self.md
+        fmu = self.fmu
+        self._solver = CVodeSolver(
+            nx=md.numberOfContinuousStates,
+            nz=md.numberOfEventIndicators,
+            get_x=fmu.getContinuousStates,
+            set_x=fmu.setContinuousStates,
+            get_dx=fmu.getDerivatives,
+            get_z=fmu.getEventIndicators,
+            get_nominals=fmu.getNominalsOfContinuousStates,
+            set_time=fmu.setTime,
+            input=self._input,
+            startTime=t,
+            relativeTolerance=self.tolerance or 1e-8,
+            maxNumSteps=1_000_000,
+        )
+
+    # -- time --
+
+    def advance(self, t: float, step: float | None = None) -> None:
+        """Simulate from the current time to t (communication points at the inputs'
+        breakpoints, every `step` if given, and t), then apply the inputs at t."""
+        if t < self.time:
+            raise ArgumentError(f"cannot go back from t = {self.time:g} to t = {t:g}")
+        points = self._points(t, step)
+        for tn in points:
+            if self.interface == "CoSimulation":
+                self._apply_inputs()
+                t0 = self.time
+                self._call("fmi2DoStep", self.fmu.doStep, currentCommunicationPoint=t0, communicationStepSize=tn - t0)
+                self.time = tn
+            else:
+                self._integrate(tn)
+        self._apply_inputs()
+
+    def _apply_inputs(self) -> None:
+        if self._input is not None:
+            self._call("setting inputs", lambda: self._input.apply(self.time))
+
+    def _points(self, t: float, step: float | None) -> list[float]:
+        """Communication points in (time, t]: the grid start + k*step, the input table's
+        times (so piecewise-linear inputs are followed exactly), and t."""
+        pts = {t}
+        if step is not None:
+            k = math.floor((self.time - self.start_time) / step + 1e-9) + 1
+            while self.start_time + k * step < t * (1 - 1e-12):
+                pts.add(self.start_time + k * step)
+                k += 1
+        if self._input is not None and self._input.t is not None:
+            pts.update(float(x) for x in np.unique(self._input.t) if self.time < x < t)
+        return sorted(p for p in pts if p > self.time)
+
+    def _integrate(self, t_end: float) -> None:
+        fmu, solver = self.fmu, self._solver
+        while self.time < t_end:
+            t_next = min(t_end, self._next_event)
+            state_event, _, time = self._call("integrating (CVode)", solver.step, self.time, t_next)
+            self.time = time
+            self._call("fmi2SetTime", fmu.setTime, time)
+            if self._input is not None:
+                self._input.apply(time, discrete=False)
+            step_event = False
+            if self.md.modelExchange.needsCompletedIntegratorStep:
+                step_event, terminate = self._call("fmi2CompletedIntegratorStep", fmu.completedIntegratorStep)
+                if terminate:
+                    raise FMUCallError(f"FMU '{self.md.modelName}' asked to terminate at t = {time:g}")
+            time_event = time >= self._next_event
+            if state_event or step_event or time_event:
+                self._call("fmi2EnterEventMode", fmu.enterEventMode)
+                self._me_event_iteration()
+                self._call("fmi2EnterContinuousTimeMode", fmu.enterContinuousTimeMode)
+                solver.reset(time)
+            if time >= t_end or math.isclose(time, t_end, rel_tol=1e-14, abs_tol=1e-14):
+                self.time = t_end
+                break
+
+    # -- values --
+
+    def get(self, vrs) -> np.ndarray:
+        vrs = list(vrs)
+        if not vrs:
+            return np.zeros(0)
+        return np.array(self._call("fmi2GetReal", lambda: self.fmu.getReal(vrs)), dtype=float)
+
+    def set(self, vrs, values) -> None:
+        vrs = list(vrs)
+        if vrs:
+            self._call("fmi2SetReal", lambda: self.fmu.setReal(vrs, [float(v) for v in values]))
+
+    def directional_derivative(self, unknowns, knowns, seeds) -> list[float]:
+        return self._call(
+            "fmi2GetDirectionalDerivative",
+            lambda: self.fmu.getDirectionalDerivative(list(unknowns), list(knowns), list(seeds)),
+        )
+
+    def set_states(self, x: np.ndarray) -> None:
+        arr = (ctypes.c_double * len(x))(*x)
+        self._call("fmi2SetContinuousStates", lambda: self.fmu.setContinuousStates(arr, len(x)))
+
+    def get_states(self, n: int) -> np.ndarray:
+        arr = (ctypes.c_double * n)()
+        self._call("fmi2GetContinuousStates", lambda: self.fmu.getContinuousStates(arr, n))
+        return np.array(arr[:], dtype=float)
+
+    def get_derivatives(self, n: int) -> np.ndarray:
+        arr = (ctypes.c_double * n)()
+        self._call("fmi2GetDerivatives", lambda: self.fmu.getDerivatives(arr, n))
+        return np.array(arr[:], dtype=float)
+
+    # -- end --
+
+    def close(self) -> None:
+        if self._alive:
+            self._alive = False
+            self._solver = None
+            try:
+                self.fmu.terminate()
+            except Exception:
+                pass
+            try:
+                self.fmu.freeInstance()
+            except Exception:
+                pass
+        with _LOG_LOCK:
+            _LOGS.pop(self.name, None)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()

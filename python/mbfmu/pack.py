@@ -1,0 +1,54 @@
+"""`pack(model, out)`: build a model file's FMU with the `mbfmu` command-line tool.
+
+The tool is found as $MBFMU_BIN, else `mbfmu` on PATH, else the build of the repository
+this package sits in (`target/release/mbfmu`, as after `cargo build --release`).
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+from pathlib import Path
+
+from .errors import ArgumentError, FMUNotFoundError, MbfmuError
+
+_REPO = Path(__file__).resolve().parents[2]
+
+
+def cli() -> Path:
+    """Path of the `mbfmu` executable."""
+    env = os.environ.get("MBFMU_BIN")
+    if env:
+        if not Path(env).is_file():
+            raise MbfmuError(f"MBFMU_BIN={env} is not a file")
+        return Path(env)
+    target = Path(os.environ.get("CARGO_TARGET_DIR", _REPO / "target")) / "release" / "mbfmu"
+    if target.is_file():
+        return target
+    found = shutil.which("mbfmu")
+    if found:
+        return Path(found)
+    raise MbfmuError(
+        "the mbfmu command-line tool was not found: build it with `cargo build --release` in the repository, "
+        "put it on PATH, or set MBFMU_BIN"
+    )
+
+
+def pack(model, out=None, out_dir=None) -> Path:
+    """Pack `model` (an mbfmu model file) into the FMU `out` (default: the model's name
+    with .fmu beside it); `out_dir` also writes the unzipped FMU there. Returns `out`.
+    A model error is raised as ArgumentError with the tool's `file:line:col` message."""
+    model = Path(model)
+    if not model.is_file():
+        raise FMUNotFoundError(f"model file '{model}' does not exist")
+    out = Path(out) if out is not None else model.with_suffix(".fmu")
+    args = [str(cli()), "pack", str(model), "-o", str(out)]
+    if out_dir is not None:
+        args += ["--out-dir", str(out_dir)]
+    r = subprocess.run(args, capture_output=True, text=True)
+    if r.returncode == 2:
+        raise ArgumentError(r.stderr.strip())
+    if r.returncode != 0:
+        raise MbfmuError(f"mbfmu pack failed (exit {r.returncode}): {r.stderr.strip()}")
+    return out
