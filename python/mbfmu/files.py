@@ -49,6 +49,11 @@ def _text(v) -> str:
 def _build(d: dict) -> Linearization:
     try:
         kw = {k: [str(s) for s in d.get(k, [])] for k in _LISTS}
+        # Files without names (the CLI's npz and mat) get positional ones: x1.., u1.., y1..
+        shapes = {"states": np.shape(d["A"])[0], "inputs": np.shape(d["B"])[1], "outputs": np.shape(d["C"])[0]}
+        for k, letter in (("states", "x"), ("inputs", "u"), ("outputs", "y")):
+            if k not in d:
+                kw[k] = [f"{letter}{i + 1}" for i in range(shapes[k])]
         n, m, p = len(kw["states"]), len(kw["inputs"]), len(kw["outputs"])
         mats = {
             k: np.asarray(d[k], dtype=float).reshape(shape)

@@ -55,17 +55,28 @@ def check_times(what: str, at, start: float) -> list[float]:
     return out
 
 
-def _step_of(md, interface: str, step: float | None) -> float | None:
+def _step_of(md, interface: str, step: float | None, inputs=None, span: float = 1.0) -> float | None:
+    """The communication step: `step`; else the FMU's fixed step if it cannot vary it;
+    else, with inputs an FMU cannot interpolate, the DefaultExperiment's stepSize (or
+    fmpy's automatic interval), so held inputs follow the signal; else None (one step
+    to each time and input breakpoint)."""
     if step is not None:
         if not (step > 0 and math.isfinite(step)):
             raise ArgumentError(f"step: {step} must be a positive communication step")
         return float(step)
+    if interface != "CoSimulation":
+        return None
     cs = md.coSimulation
-    if interface == "CoSimulation" and not cs.canHandleVariableCommunicationStepSize:
+    ex_step = md.defaultExperiment.stepSize if md.defaultExperiment is not None else None
+    if not cs.canHandleVariableCommunicationStepSize:
         if cs.fixedInternalStepSize:
             return float(cs.fixedInternalStepSize)
-        if md.defaultExperiment is not None and md.defaultExperiment.stepSize:
-            return float(md.defaultExperiment.stepSize)
+        if ex_step:
+            return float(ex_step)
+    if inputs is not None and not cs.canInterpolateInputs:
+        from fmpy.util import auto_interval
+
+        return float(ex_step) if ex_step else float(auto_interval(max(span, 1e-9)))
     return None
 
 
@@ -157,7 +168,7 @@ def linearize_opened(
     start = start_time_of(md)
     times = check_times(f"FMU '{md.modelName}'", at, start)
     check_start_values(md, dict(start_values or {}))
-    step = _step_of(md, interface, step)
+    step = _step_of(md, interface, step, inputs, max(times) - start)
     tol = tolerance if tolerance is not None else default_tolerance(md)
     if tol is not None and not (tol > 0 and math.isfinite(tol)):
         raise ArgumentError(f"tolerance: {tol} must be positive")
