@@ -585,12 +585,40 @@ impl Simulator {
         self.dae.inputs_at(self.radau.t)
     }
 
+    /// Current slope of input `i` (0 unless set by [`Simulator::set_input_derivative`]).
+    pub fn input_slope(&self, i: usize) -> f64 {
+        self.dae.slopes[i]
+    }
+
     /// Set input `i` from now on: held constant (slope 0) until changed.
     pub fn set_input(&mut self, i: usize, v: f64) {
         self.rebase_inputs();
         self.dae.inputs[i] = v;
         self.dae.slopes[i] = 0.0;
         self.acc = None;
+    }
+
+    /// Re-solve, at the current point, the unknowns that follow the inputs at once: the
+    /// algebraic user unknowns Ẋ, V (seed Eq. 7b holds at every instant) and the
+    /// acceleration unknowns, with the multipliers, as at initialization. Called after
+    /// inputs change at a communication point, so that outputs, user variables and the
+    /// linearization read there see the new inputs.
+    pub fn resolve_user_unknowns(&mut self) -> Result<(), EngineError> {
+        let l = &self.dae.lay;
+        if l.nz() == l.nx {
+            return Ok(());
+        }
+        let (z0, nz, lam0) = (l.z(), l.nz(), l.lam());
+        let (q, u) = (self.q().to_vec(), self.u().to_vec());
+        let t = self.radau.t;
+        let mut z = self.user_values().to_vec();
+        let inputs = self.dae.inputs_at(t);
+        let (udot, lam) = init::consistent_accelerations(&self.dae.sys, &q, &u, t, &inputs, &mut z, &mut self.acc_lu)
+            .map_err(EngineError::Numeric)?;
+        self.radau.y[z0..z0 + nz].copy_from_slice(&z);
+        self.radau.y[lam0..lam0 + lam.len()].copy_from_slice(&lam);
+        self.acc = Some((udot, lam));
+        Ok(())
     }
 
     /// Set the time derivative of input `i`: from now on it changes linearly (FMI

@@ -242,6 +242,7 @@ impl Instance {
                 t => targets.push((t, v)),
             }
         }
+        let mut moved = false;
         for (t, v) in targets {
             match t {
                 Target::Parameter(k) => {
@@ -252,13 +253,23 @@ impl Instance {
                     self.config.inputs[k] = v;
                     self.config.slopes[k] = 0.0;
                     if self.initialized() {
-                        self.built.as_mut().expect("initialized").sim.set_input(k, v);
+                        let sim = &mut self.built.as_mut().expect("initialized").sim;
+                        // Setting the value an input already has (fmpy sets every input at
+                        // every step) leaves the engine state, and so the trajectory, alone.
+                        if sim.inputs()[k] != v || sim.input_slope(k) != 0.0 {
+                            sim.set_input(k, v);
+                            moved = true;
+                        }
                     } else {
                         self.dirty = true;
                     }
                 }
                 _ => unreachable!("refused above"),
             }
+        }
+        if moved {
+            let sim = &mut self.built.as_mut().expect("initialized").sim;
+            sim.resolve_user_unknowns().map_err(|e| format!("the user variables cannot follow the new inputs: {e}"))?;
         }
         Ok(())
     }

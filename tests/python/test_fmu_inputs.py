@@ -74,3 +74,24 @@ def test_setting_the_input_again_ends_the_slope(rotor):
     finally:
         sl.terminate()
         sl.freeInstance()
+
+
+def test_outputs_and_user_variables_follow_an_input_set_at_a_communication_point(packed):
+    # cart_pendulum_pid: e = theta - r and force = kp e + ki xi + kd theta' are algebraic
+    # (seed Eq. 7b): setting r at a communication point must move them at once (the
+    # coupled-system master reads outputs right after setting inputs). Upright at rest,
+    # r = 0.1 gives e = -0.1 and force = 60 * -0.1 = -6 exactly (1e-12: one Newton solve).
+    p = packed("cart_pendulum_pid")
+    s = new_slave(p)
+    initialize(s, tol=1e-8)
+    vr = p.vr
+    assert s.getReal([vr["force"]])[0] == 0.0
+    s.setReal([vr["r"]], [0.1])
+    force, e = s.getReal([vr["force"], vr["e"]])
+    assert abs(force + 6.0) < 1e-12 and abs(e + 0.1) < 1e-12
+    s.doStep(0.0, 0.01)
+    s.setReal([vr["r"]], [0.0])
+    theta, force, e = s.getReal([vr["angle"], vr["force"], vr["e"]])
+    assert abs(e - theta) < 1e-12
+    s.terminate()
+    s.freeInstance()
