@@ -19,8 +19,9 @@ def test_not_an_fmu(tmp_path):
         mbfmu.linearize(junk, at=0.0)
 
 
-@pytest.mark.parametrize("at,match", [(-1.0, "before the start time 0"), (float("nan"), "not finite"),
-                                      ([], "no times")])
+@pytest.mark.parametrize(
+    "at,match", [(-1.0, "before the start time 0"), (float("nan"), "not finite"), ([], "no times")]
+)
 def test_bad_times(packed, at, match):
     with pytest.raises(mbfmu.ArgumentError, match=match):
         mbfmu.linearize(packed("pendulum"), at=at)
@@ -51,8 +52,10 @@ def test_bad_step_and_tolerance(packed):
 
 def test_pack_reports_the_model_error_with_its_location(tmp_path):
     bad = tmp_path / "bad.xml"
-    bad.write_text('<multibody name="bad" version="1">\n  <body name="b" mass="-1" inertia="1 1 1" '
-                   'position="0 0 0"/>\n</multibody>\n')
+    bad.write_text(
+        '<multibody name="bad" version="1">\n  <body name="b" mass="-1" inertia="1 1 1" '
+        'position="0 0 0"/>\n</multibody>\n'
+    )
     with pytest.raises(mbfmu.ArgumentError, match=r"bad\.xml:2:\d+: body 'b'"):
         mbfmu.pack(bad, tmp_path / "bad.fmu")
     with pytest.raises(mbfmu.FMUNotFoundError):

@@ -10,7 +10,7 @@ from conftest import ROOT
 
 def test_readme_python_example_runs(tmp_path):
     text = (ROOT / "README.md").read_text()
-    section = text[text.index("## Python"):]
+    section = text[text.index("## Python") :]
     code = re.search(r"```python\n(.*?)```", section, re.S).group(1)
     assert len(code.strip().splitlines()) <= 12
     shutil.copytree(ROOT / "models", tmp_path / "models")
