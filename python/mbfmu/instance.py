@@ -173,11 +173,16 @@ class Instance:
             _LOGS[self.name] = []
         cls = FMU2Slave if interface == "CoSimulation" else FMU2Model
         info = md.coSimulation if interface == "CoSimulation" else md.modelExchange
-        self.fmu = cls(
-            guid=md.guid, unzipDirectory=unzipdir, modelIdentifier=info.modelIdentifier, instanceName=self.name
+        self.time = math.nan
+        self.fmu = self._call(
+            "loading the FMU's shared library",
+            cls,
+            guid=md.guid,
+            unzipDirectory=unzipdir,
+            modelIdentifier=info.modelIdentifier,
+            instanceName=self.name,
         )
         self._callbacks = _callbacks()
-        self.time = math.nan
         self.tolerance = tolerance
         self._input = None
         self._solver = None
@@ -279,12 +284,18 @@ class Instance:
             get_dx=fmu.getDerivatives,
             get_z=fmu.getEventIndicators,
             get_nominals=fmu.getNominalsOfContinuousStates,
-            set_time=fmu.setTime,
+            set_time=self._set_time_and_inputs,
             input=self._input,
             startTime=t,
             relativeTolerance=self.tolerance or 1e-8,
             maxNumSteps=1_000_000,
         )
+
+    def _set_time_and_inputs(self, t: float) -> None:
+        # fmpy's CVode right-hand side sets only the time: continuous inputs follow here.
+        self.fmu.setTime(t)
+        if self._input is not None:
+            self._input.apply(t, discrete=False)
 
     # -- time --
 

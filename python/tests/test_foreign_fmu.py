@@ -81,3 +81,14 @@ def test_ignoring_declared_dependencies_gives_the_same_matrices(foreign):
     b = mbfmu.linearize(foreign(), at=1.0, use_dependencies=False)[0]
     for k in "ABCD":
         assert np.array_equal(getattr(a, k), getattr(b, k))
+
+
+def test_model_exchange_follows_time_varying_inputs(foreign):
+    # u(t) = t through CVode (inputs applied inside the right-hand side) against the
+    # Co-Simulation interface, which holds u over each communication step h (first order
+    # in h): its Richardson extrapolation 2 x(h/2) - x(h) is O(h^2) ≈ 1e-6 accurate.
+    sig = np.array([(0.0, 0.0), (2.0, 2.0)], dtype=[("time", float), ("u", float)])
+    me = mbfmu.linearize(foreign(), at=1.5, inputs=sig, interface="ModelExchange")[0]
+    cs = [mbfmu.linearize(foreign(), at=1.5, inputs=sig, interface="CoSimulation", step=h)[0].x0 for h in (2e-3, 1e-3)]
+    assert me.u0.tolist() == [1.5]
+    assert np.max(np.abs(me.x0 - (2 * cs[1] - cs[0]))) < 1e-5
