@@ -78,8 +78,7 @@ def test_files_written_by_the_cli_are_loaded(packed, tmp_path, fmt):
         for k in "ABCD":
             want = getattr(ref, k)
             assert np.max(np.abs(getattr(g, k) - want)) <= 1e-9 * max(1.0, np.max(np.abs(want))), k
-        # Files without names (the CLI's npz/mat) get positional ones.
-        assert g.states == (ref.states if fmt == "json" else [f"x{i + 1}" for i in range(5)])
+        assert g.states == ref.states and g.inputs == ref.inputs and g.outputs == ref.outputs
 
 
 def test_eigen_table_has_the_rows_of_the_cli(packed):
@@ -90,11 +89,12 @@ def test_eigen_table_has_the_rows_of_the_cli(packed):
     assert r.returncode == 0, r.stderr
     lines = r.stdout.splitlines()
     start = next(i for i, line in enumerate(lines) if "Undmp. Freq." in line) + 1
+    # Columns: rad/s, Hz, damping ratio, real, imaginary.
     cli_rows = [[float(x) for x in line.split()] for line in lines[start:] if line.strip()]
     rows = mbfmu.linearize(packed("double_pendulum"), tolerance=1e-10)[0].eigen_table()
     assert len(rows) == len(cli_rows) == 2
     for ours, theirs in zip(rows, cli_rows, strict=True):
-        got = [ours.frequency, ours.damping, ours.real, ours.imag]
+        got = [ours.frequency, ours.frequency_hz, ours.damping, ours.real, ours.imag]
         for g, t in zip(got, theirs, strict=True):
             assert g == pytest.approx(t, rel=1e-6, abs=1e-12) or (np.isnan(g) and np.isnan(t))
     assert [r.frequency_hz for r in rows] == pytest.approx([r.frequency / (2 * np.pi) for r in rows], rel=1e-15)
@@ -117,3 +117,12 @@ def test_to_control_keeps_names_and_poles(lins):
 def test_str_shows_the_table(lins):
     text = str(lins[0])
     assert "cart_pendulum_pid" in text and "Damping Ratio" in text and "(Hz)" in text
+
+
+def test_files_without_names_get_positional_names(tmp_path):
+    # Files from before the CLI wrote names (only A B C D time) still load.
+    path = tmp_path / "old.npz"
+    np.savez(path, A=np.eye(2), B=np.ones((2, 1)), C=np.ones((1, 2)), D=np.zeros((1, 1)), time=np.array([[0.5]]))
+    (lin,) = mbfmu.load(path)
+    assert lin.states == ["x1", "x2"] and lin.inputs == ["u1"] and lin.outputs == ["y1"]
+    assert lin.time == 0.5

@@ -10,7 +10,7 @@ use clap::Args;
 use super::CliError;
 use crate::dae::{SimOptions, Simulator};
 use crate::linearize::eigen::{eigen_table, format_table};
-use crate::linearize::{Linearization, Selection, linearize, select_states};
+use crate::linearize::{Linearization, Selection, linearize, select_states, state_values};
 use crate::model::parse::load_file;
 
 /// Arguments of `mbfmu linearize`.
@@ -38,8 +38,10 @@ pub struct LinearizeArgs {
     pub threads: usize,
 }
 
-/// Run the command.
-pub fn run(args: &LinearizeArgs, out: &mut dyn Write) -> Result<(), CliError> {
+/// Run the command. The report (states, equilibrium, eigenvalue tables) goes to `out`,
+/// except with `--format json` and no `--out`: then `out` gets only the JSON and the
+/// report goes to `report` (stderr), so the output pipes into a JSON reader.
+pub fn run(args: &LinearizeArgs, out: &mut dyn Write, report: &mut dyn Write) -> Result<(), CliError> {
     let mut model = load_file(&args.model)?;
     // --static: start from static equilibrium, as <analysis static="true"/> does.
     model.static_analysis |= args.r#static;
@@ -59,18 +61,25 @@ pub fn run(args: &LinearizeArgs, out: &mut dyn Write) -> Result<(), CliError> {
     let mut sim = Simulator::new(&model, SimOptions { tol, max_step: None }, t0)?;
     let sel = select_states(sim.system(), sim.q(), t0, &sim.inputs()).map_err(|e| CliError::Engine(e.into()))?;
     let io_err = |e| CliError::io("writing output", e);
-    print_selection(&sel, out).map_err(io_err)?;
+    let json_stdout = args.format == "json" && args.out.is_none();
+    let rep: &mut dyn Write = if json_stdout { &mut *report } else { &mut *out };
+    print_selection(&sel, rep).map_err(io_err)?;
+    if model.static_analysis {
+        let v = state_values(&mut sim, &sel)?;
+        let items: Vec<String> = sel.states.iter().zip(&v.s).map(|(s, x)| format!("{} = {x:.9e}", s.name)).collect();
+        writeln!(rep, "static equilibrium at t = {t0}: {}", items.join(", ")).map_err(io_err)?;
+    }
     let mut results = Vec::new();
     for &t in &times {
         sim.advance(t)?;
         let lin = linearize(&mut sim, &sel, args.threads)?;
         let rows = eigen_table(&lin.a).map_err(|e| CliError::Engine(e.into()))?;
-        writeln!(out, "\nt = {t}: {} states, {} eigenvalues", lin.states.len(), lin.a.nrows()).map_err(io_err)?;
-        write!(out, "{}", format_table(&rows)).map_err(io_err)?;
+        writeln!(rep, "\nt = {t}: {} states, {} eigenvalues", lin.states.len(), lin.a.nrows()).map_err(io_err)?;
+        write!(rep, "{}", format_table(&rows)).map_err(io_err)?;
         let (s0, s1) = (sel.states.len(), sel.velocities.len());
         if s1 < s0 {
             writeln!(
-                out,
+                rep,
                 "note: at least s0 - s1 = {} eigenvalues are zero because of the non-holonomic constraints: \
                  {s0} position states but {s1} velocity states, so {} position combinations only integrate \
                  the velocities and never feed back",

@@ -70,6 +70,8 @@ pub fn main() -> ExitCode {
     let _ = std::panic::take_hook();
     match result {
         Ok(Ok(())) => ExitCode::SUCCESS,
+        // A closed pipe (`mbfmu simulate m.xml | head`) is the reader's choice, not a failure.
+        Ok(Err(CliError::Io { source, .. })) if source.kind() == std::io::ErrorKind::BrokenPipe => ExitCode::SUCCESS,
         Ok(Err(e)) => {
             eprintln!("{e}");
             ExitCode::from(e.exit_code())
@@ -94,7 +96,7 @@ pub fn execute(command: &Command) -> Result<(), CliError> {
         Command::Check { model } => check::check(model, &mut out),
         Command::Simulate(args) => simulate::simulate(args, &mut out),
         Command::Pack(args) => pack::run(args, &mut out),
-        Command::Linearize(args) => linearize::run(args, &mut out),
+        Command::Linearize(args) => linearize::run(args, &mut out, &mut std::io::stderr().lock()),
         Command::Run => run::run(&mut out),
     }
 }

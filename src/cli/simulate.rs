@@ -37,6 +37,9 @@ pub struct SimulateArgs {
     /// Also write every coordinate q and velocity u.
     #[arg(long)]
     pub states: bool,
+    /// Start from static equilibrium (as `<analysis static="true"/>`).
+    #[arg(long = "static")]
+    pub r#static: bool,
 }
 
 /// Start, end, step and tolerance of one simulation run.
@@ -152,7 +155,8 @@ fn write_csv_row(out: &mut dyn Write, t: f64, values: &[f64]) -> std::io::Result
 
 /// Run `mbfmu simulate`; the CSV goes to `--out` or else to `stdout`.
 pub fn simulate(args: &SimulateArgs, stdout: &mut dyn Write) -> Result<(), CliError> {
-    let model = load_file(&args.model)?;
+    let mut model = load_file(&args.model)?;
+    model.static_analysis |= args.r#static;
     let settings = RunSettings::resolve(&model, args.end, args.step, args.tol)?;
     let points = settings.points()?;
     let opts = SimOptions { tol: settings.tol, max_step: None };

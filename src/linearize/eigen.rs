@@ -38,12 +38,14 @@ pub fn eigen_table(a: &Mat<f64>) -> Result<Vec<EigenRow>, String> {
     Ok(rows)
 }
 
-/// The table as text, in the seed's format.
+/// The table as text, in the seed's format with the frequency also in Hz (|λ|/2π).
 pub fn format_table(rows: &[EigenRow]) -> String {
     let mut s = String::new();
-    let _ = writeln!(s, "{:>14} {:>14} {:>14} {:>14}", "Undmp. Freq.", "Damping Ratio", "Real", "Imag");
+    let _ = writeln!(s, "{:>14} {:>14} {:>14} {:>14} {:>14}", "Undmp. Freq.", "(Hz)", "Damping Ratio", "Real", "Imag");
     for r in rows {
-        let _ = writeln!(s, "{:>14.6e} {:>14.6e} {:>14.6e} {:>14.6e}", r.frequency, r.damping, r.re, r.im);
+        let hz = r.frequency / (2.0 * std::f64::consts::PI);
+        let _ =
+            writeln!(s, "{:>14.6e} {:>14.6e} {:>14.6e} {:>14.6e} {:>14.6e}", r.frequency, hz, r.damping, r.re, r.im);
     }
     s
 }
