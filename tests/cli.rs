@@ -62,7 +62,8 @@ fn every_example_model_checks_with_the_documented_degrees_of_freedom() {
         let path = model_path(name);
         let o = mbfmu(&["check", &path]);
         assert!(o.status.success(), "{path}: {}", stderr(&o));
-        assert!(stdout(&o).contains("degrees of freedom"), "{path}: {}", stdout(&o));
+        let unit = if dof == 1 { "degree of freedom" } else { "degrees of freedom" };
+        assert!(stdout(&o).contains(&format!("; {dof} {unit}")), "{path}: {}", stdout(&o));
         let model =
             load_file(Path::new(env!("CARGO_MANIFEST_DIR")).join(&path).as_path()).unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(model.summary().dof, dof, "{path}");
@@ -219,4 +220,37 @@ fn run_prints_the_eigenvalue_table_and_a_table_of_the_default_model() {
     assert_eq!(text.lines().count(), 5 + 23, "{text}");
     let last: Vec<&str> = text.lines().last().unwrap().split_whitespace().collect();
     assert_eq!(last[0], "2.000");
+}
+
+#[test]
+fn check_counts_redundant_equations_honestly() {
+    // The planar four-bar with four revolutes in 3-D: 20 equations on 18 coordinates, rank
+    // 17 (3 equations implied by the others), so 1 degree of freedom, not 18 − 20 = −2.
+    let text = std::fs::read_to_string(model_path("fourbar"))
+        .unwrap()
+        .replace(r#"<joint name="crank_pin" type="spherical""#, r#"<joint name="crank_pin" type="revolute""#)
+        .replace(r#"<joint name="rocker_pin" type="universal""#, r#"<joint name="rocker_pin" type="revolute""#)
+        .replace(
+            r#"<marker name="B" position="b/2, 0, 0" z_axis="0 1 0"/>"#,
+            r#"<marker name="B" position="b/2, 0, 0"/>"#,
+        );
+    let file = scratch("fourbar_revolutes.xml");
+    std::fs::write(&file, text).unwrap();
+    let o = mbfmu(&["check", &file.display().to_string()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = stdout(&o);
+    let line = out.lines().find(|l| l.starts_with("positions: ")).unwrap_or_else(|| panic!("{out}"));
+    assert!(line.starts_with("positions: 20 constraint equations, 17 independent, 3 redundant (joint '"), "{line}");
+    assert!(line.ends_with("; 1 degree of freedom"), "{line}");
+    // Non-holonomic: the bicycle's 4 no-slip rows are independent: 7 − 4 = 3 velocity dof.
+    let o = mbfmu(&["check", &model_path("benchmark_bicycle")]);
+    let out = stdout(&o);
+    assert!(
+        out.contains("positions: 17 constraint equations, 17 independent, 0 redundant; 7 degrees of freedom"),
+        "{out}"
+    );
+    assert!(
+        out.contains("velocities: 4 non-holonomic equations, 4 independent; 3 velocity degrees of freedom"),
+        "{out}"
+    );
 }

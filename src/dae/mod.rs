@@ -1,6 +1,7 @@
 //! The DAE layer: residual and sparse Jacobians of the equations of motion (Eq. 13a–13e),
 //! initialization (assembly), and the integrator (Radau IIA on the stabilized system).
 
+pub mod counts;
 pub mod equations;
 pub mod init;
 pub mod radau;
