@@ -94,3 +94,24 @@ def test_continue_a_host_simulation_then_linearize_the_instance(packed, tmp_path
     ref = mbfmu.linearize(path, at=[0.5, 0.7], tolerance=1e-8, step=0.05)
     assert np.array_equal(here.A, ref[0].A)
     assert np.max(np.abs(later.A - ref[1].A)) <= 1e-12 * np.max(np.abs(ref[1].A))
+
+
+def test_without_set_stop_time_false_the_fmu_refuses_steps_past_the_stop_time(packed, tmp_path):
+    # FMI 2.0: with a stop time defined in fmi2SetupExperiment, a doStep past it is an
+    # error. simulate_fmu passes its stop_time unless set_stop_time=False (README).
+    from fmpy.fmi1 import FMICallException
+
+    path = packed("pendulum")
+    md = read_model_description(str(path))
+    unzipdir = extract(str(path), unzipdir=str(tmp_path / "u"))
+    inst = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir, modelIdentifier=md.coSimulation.modelIdentifier)
+    inst.instantiate()
+    simulate_fmu(unzipdir, stop_time=0.2, output_interval=0.1, fmu_instance=inst, terminate=False,
+                 model_description=md)
+    with pytest.raises(FMICallException):
+        inst.doStep(0.2, 0.1)
+    with pytest.raises(mbfmu.FMUCallError, match="fmi2DoStep"):
+        mbfmu.linearize(inst, at=0.3)
+    assert mbfmu.linearize(inst)[0].time == pytest.approx(0.2, abs=1e-12)
+    inst.terminate()
+    inst.freeInstance()
