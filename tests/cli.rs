@@ -254,3 +254,77 @@ fn check_counts_redundant_equations_honestly() {
         "{out}"
     );
 }
+
+/// A free rotor (J = 0.5) driven by the input torque T about its bearing: J ω' = T(t).
+const ROTOR: &str = r#"<multibody name="rotor" version="1">
+  <ground><marker name="O" position="0 0 0"/></ground>
+  <body name="r" mass="2" inertia="1 1 0.5" position="0 0 0"><marker name="axis" position="0 0 0"/></body>
+  <joint name="bearing" type="revolute" i="r.axis" j="ground.O"/>
+  <input name="T"/>
+  <gforce name="drive" i="r.cm" torque="0 0 T"/>
+  <output name="w" function="wz(r.cm)"/>
+</multibody>
+"#;
+
+fn rotor_run(csv: &str, tag: &str) -> Vec<(f64, f64)> {
+    let model = scratch(&format!("rotor_{tag}.xml"));
+    std::fs::write(&model, ROTOR).unwrap();
+    let input = scratch(&format!("rotor_{tag}.csv"));
+    std::fs::write(&input, csv).unwrap();
+    let o = mbfmu(&[
+        "simulate",
+        &model.display().to_string(),
+        "--input",
+        &input.display().to_string(),
+        "--end",
+        "2",
+        "--step",
+        "0.25",
+        "--tol",
+        "1e-10",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    stdout(&o)
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+            (v[0], v[1])
+        })
+        .collect()
+}
+
+#[test]
+fn simulate_follows_a_piecewise_linear_input_file() {
+    // T = 2t up to t = 1, then 2: ω = t²/J = 2t² up to 1, then 2 + 4(t − 1) (exact for
+    // Radau on a polynomial; 1e-9).
+    for (t, w) in rotor_run("time,T\n0,0\n1,2\n2,2\n", "ramp") {
+        let want = if t <= 1.0 { 2.0 * t * t } else { 2.0 + 4.0 * (t - 1.0) };
+        assert!((w - want).abs() < 1e-9, "t {t}: {w} vs {want}");
+    }
+    // A repeated time is a jump: T = 0 before 0.5, 1 after: ω = 2 (t − 0.5)⁺.
+    for (t, w) in rotor_run("time,T\n0,0\n0.5,0\n0.5,1\n2,1\n", "step") {
+        let want = 2.0 * (t - 0.5).max(0.0);
+        assert!((w - want).abs() < 1e-9, "t {t}: {w} vs {want}");
+    }
+}
+
+#[test]
+fn bad_input_files_are_located() {
+    let model = scratch("rotor_bad.xml");
+    std::fs::write(&model, ROTOR).unwrap();
+    for (csv, want) in [
+        ("time,torque\n0,1\n", ":1: column 2 'torque' is not an input of model 'rotor' (inputs: T)"),
+        ("time,T\n0,1\n0.5,x\n", ":3: column 2 'T': 'x' is not a finite number"),
+        ("time,T\n1,1\n0.5,1\n", ":3: time 0.5 is before the previous row's 1"),
+        ("t,T\n0,1\n", ":1: the first column must be 'time'"),
+    ] {
+        let input = scratch("bad_input.csv");
+        std::fs::write(&input, csv).unwrap();
+        for cmd in ["simulate", "linearize"] {
+            let o = mbfmu(&[cmd, &model.display().to_string(), "--input", &input.display().to_string()]);
+            assert_eq!(o.status.code(), Some(2), "{cmd} {csv}: {}", stderr(&o));
+            assert!(stderr(&o).contains(&format!("bad_input.csv{want}")), "{cmd}: {}", stderr(&o));
+        }
+    }
+}

@@ -71,6 +71,29 @@ def _callbacks() -> fmi2CallbackFunctions:
     return cb
 
 
+class _Slopes:
+    """Slopes of the continuous real inputs of an fmpy input array, segment ahead of t
+    (the later of repeated times; 0 before the first and after the last row)."""
+
+    def __init__(self, md, signals):
+        names = signals.dtype.names
+        self.t = np.asarray(signals[names[0]], dtype=float)
+        vars_ = [
+            v
+            for v in md.modelVariables
+            if v.causality == "input" and v.type == "Real" and v.variability == "continuous" and v.name in names
+        ]
+        self.vrs = [v.valueReference for v in vars_]
+        self.cols = [np.asarray(signals[v.name], dtype=float) for v in vars_]
+
+    def at(self, time: float) -> list[float]:
+        k = int(np.searchsorted(self.t, time, side="right")) - 1
+        if k < 0 or k + 1 >= len(self.t) or self.t[k + 1] <= self.t[k]:
+            return [0.0] * len(self.vrs)
+        dt = self.t[k + 1] - self.t[k]
+        return [float((c[k + 1] - c[k]) / dt) for c in self.cols]
+
+
 # --- opening ------------------------------------------------------------------------
 
 
@@ -202,6 +225,7 @@ class Instance:
         self.time = self.start_time = float(time)
         self.tolerance = None
         self._input = None
+        self._slopes = None
         self._solver = None
         self._next_event = math.inf
         self._alive = False  # not ours to terminate or free
@@ -253,8 +277,12 @@ class Instance:
         )
         if sv:
             raise ArgumentError(f"FMU '{self.md.modelName}': start values not set: {', '.join(sv)}")
-        interp = cs and bool(self.md.coSimulation.canInterpolateInputs) and inputs is not None
-        self._input = self._call("reading inputs", lambda: Input(fmu, self.md, inputs, set_input_derivatives=interp))
+        # Slopes are set here, not by fmpy's Input(set_input_derivatives=True), whose buffer
+        # holds exactly 9 inputs (fmpy 0.3.x).
+        self._slopes = None
+        if cs and bool(self.md.coSimulation.canInterpolateInputs) and inputs is not None:
+            self._slopes = _Slopes(self.md, inputs)
+        self._input = self._call("reading inputs", lambda: Input(fmu, self.md, inputs))
         self._apply_inputs()
         self._call("fmi2ExitInitializationMode", fmu.exitInitializationMode)
         if not cs:
@@ -317,7 +345,17 @@ class Instance:
 
     def _apply_inputs(self) -> None:
         if self._input is not None:
-            self._call("setting inputs", lambda: self._input.apply(self.time))
+            # after_event: at a repeated time the later row holds from now on (as the slopes).
+            self._call("setting inputs", lambda: self._input.apply(self.time, after_event=True))
+        if getattr(self, "_slopes", None) is not None and self._slopes.vrs:
+            slopes = self._slopes.at(self.time)
+            self._call(
+                "fmi2SetRealInputDerivatives",
+                self.fmu.setRealInputDerivatives,
+                self._slopes.vrs,
+                [1] * len(slopes),
+                slopes,
+            )
 
     def _points(self, t: float, step: float | None) -> list[float]:
         """Communication points in (time, t]: the grid start + k*step, the input table's

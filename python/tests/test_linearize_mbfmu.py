@@ -106,8 +106,7 @@ def test_without_set_stop_time_false_the_fmu_refuses_steps_past_the_stop_time(pa
     unzipdir = extract(str(path), unzipdir=str(tmp_path / "u"))
     inst = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir, modelIdentifier=md.coSimulation.modelIdentifier)
     inst.instantiate()
-    simulate_fmu(unzipdir, stop_time=0.2, output_interval=0.1, fmu_instance=inst, terminate=False,
-                 model_description=md)
+    simulate_fmu(unzipdir, stop_time=0.2, output_interval=0.1, fmu_instance=inst, terminate=False, model_description=md)
     with pytest.raises(FMICallException):
         inst.doStep(0.2, 0.1)
     with pytest.raises(mbfmu.FMUCallError, match="fmi2DoStep"):
@@ -115,3 +114,46 @@ def test_without_set_stop_time_false_the_fmu_refuses_steps_past_the_stop_time(pa
     assert mbfmu.linearize(inst)[0].time == pytest.approx(0.2, abs=1e-12)
     inst.terminate()
     inst.freeInstance()
+
+
+def test_cli_input_file_and_package_inputs_give_the_same_linearization(packed, tmp_path):
+    # A reference ramp r(t) on the PID cart-pendulum: `mbfmu linearize --input` (engine
+    # called directly) and mbfmu.linearize(inputs=...) (fmpy sets values and slopes at
+    # the rows) follow the same piecewise-linear signal: same A, B, C, D (1e-9) at a
+    # moving point, and the operating point's r is the interpolated value.
+    import subprocess
+
+    from mbfmu.pack import cli
+
+    rows = [(0.0, 0.0), (0.4, 0.2), (1.0, -0.1)]
+    csv = tmp_path / "r.csv"
+    csv.write_text("time,r\n" + "".join(f"{t!r},{r!r}\n" for t, r in rows))
+    out = tmp_path / "lin.json"
+    r = subprocess.run(
+        [
+            str(cli()),
+            "linearize",
+            str(MODELS / "cart_pendulum_pid.xml"),
+            "--at",
+            "0.7",
+            "--tol",
+            "1e-9",
+            "--input",
+            str(csv),
+            "--format",
+            "json",
+            "-o",
+            str(out),
+        ],
+        capture_output=True,
+        text=True,
+    )
+    assert r.returncode == 0, r.stderr
+    (ref,) = mbfmu.load(out)
+    sig = np.array(rows, dtype=[("time", float), ("r", float)])
+    (lin,) = mbfmu.linearize(packed("cart_pendulum_pid"), at=0.7, inputs=sig, tolerance=1e-9)
+    assert lin.u0[0] == pytest.approx(0.2 - 0.3 * 0.5, abs=1e-15)
+    assert abs(lin.x0[1]) > 1e-3  # the pendulum moved: a moving point
+    for k in "ABCD":
+        want = getattr(ref, k)
+        assert np.max(np.abs(getattr(lin, k) - want)) <= 1e-9 * max(1.0, np.max(np.abs(want))), k

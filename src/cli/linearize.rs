@@ -8,6 +8,7 @@ use std::path::PathBuf;
 use clap::Args;
 
 use super::CliError;
+use super::input_csv::InputTable;
 use crate::dae::{SimOptions, Simulator};
 use crate::linearize::eigen::{eigen_table, format_table};
 use crate::linearize::{Linearization, Selection, linearize, select_states, state_values};
@@ -33,6 +34,10 @@ pub struct LinearizeArgs {
     /// Find static equilibrium first (as `<analysis static="true"/>`).
     #[arg(long = "static")]
     pub r#static: bool,
+    /// Input signals: CSV with a `time` column and one column per input (linear between
+    /// rows, as fmpy's input arrays).
+    #[arg(long, value_name = "FILE")]
+    pub input: Option<PathBuf>,
     /// Threads for the right-hand sides of the augmented system.
     #[arg(long, default_value_t = 2)]
     pub threads: usize,
@@ -58,7 +63,14 @@ pub fn run(args: &LinearizeArgs, out: &mut dyn Write, report: &mut dyn Write) ->
     if !matches!(args.format.as_str(), "table" | "json" | "npz" | "mat") {
         return Err(CliError::Usage(format!("--format {}: expected table, json, npz or mat", args.format)));
     }
+    let table = args.input.as_deref().map(|p| InputTable::read(p, &model)).transpose()?;
+    if let Some(t) = &table {
+        t.set_start(&mut model, t0);
+    }
     let mut sim = Simulator::new(&model, SimOptions { tol, max_step: None }, t0)?;
+    if let Some(t) = &table {
+        t.apply(&mut sim)?;
+    }
     let sel = select_states(sim.system(), sim.q(), t0, &sim.inputs()).map_err(|e| CliError::Engine(e.into()))?;
     let io_err = |e| CliError::io("writing output", e);
     let json_stdout = args.format == "json" && args.out.is_none();
@@ -71,7 +83,7 @@ pub fn run(args: &LinearizeArgs, out: &mut dyn Write, report: &mut dyn Write) ->
     }
     let mut results = Vec::new();
     for &t in &times {
-        sim.advance(t)?;
+        super::input_csv::advance(&mut sim, table.as_ref(), t)?;
         let lin = linearize(&mut sim, &sel, args.threads)?;
         let rows = eigen_table(&lin.a).map_err(|e| CliError::Engine(e.into()))?;
         writeln!(rep, "\nt = {t}: {} states, {} eigenvalues", lin.states.len(), lin.a.nrows()).map_err(io_err)?;

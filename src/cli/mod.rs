@@ -7,6 +7,7 @@
 
 mod check;
 mod error;
+mod input_csv;
 mod linearize;
 mod matrices;
 mod pack;

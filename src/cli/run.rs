@@ -61,7 +61,7 @@ pub fn run(out: &mut dyn Write) -> Result<(), CliError> {
     let widths: Vec<usize> = names.iter().map(|n| n.len().max(WIDTH)).collect();
     let line: Vec<String> = names.iter().zip(&widths).map(|(n, &w)| format!("{n:>w$}")).collect();
     writeln!(out, "{}", line.join(" ")).map_err(io_err)?;
-    drive(&mut sim, &points, false, |t, values| {
+    drive(&mut sim, &points, None, false, |t, values| {
         let mut cells = vec![format!("{t:>w$.3}", w = widths[0])];
         cells.extend(values.iter().zip(&widths[1..]).map(|(v, &w)| format!("{v:>w$.6}")));
         writeln!(out, "{}", cells.join(" ")).map_err(io_err)

@@ -8,6 +8,7 @@ use std::path::PathBuf;
 use clap::Args;
 
 use super::CliError;
+use super::input_csv::InputTable;
 use crate::dae::{SimOptions, Simulator};
 use crate::model::Model;
 use crate::model::parse::load_file;
@@ -40,6 +41,10 @@ pub struct SimulateArgs {
     /// Start from static equilibrium (as `<analysis static="true"/>`).
     #[arg(long = "static")]
     pub r#static: bool,
+    /// Input signals: CSV with a `time` column and one column per input (linear between
+    /// rows, as fmpy's input arrays).
+    #[arg(long, value_name = "FILE")]
+    pub input: Option<PathBuf>,
 }
 
 /// Start, end, step and tolerance of one simulation run.
@@ -111,18 +116,20 @@ pub fn communication_points(start: f64, end: f64, step: f64) -> Result<Vec<f64>,
     Ok(points)
 }
 
-/// Run `sim` through `points` (the first is its current time), calling `row(t, values)` at
-/// each point with the outputs followed, when `with_states`, by the states.
+/// Run `sim` through `points` (the first is its current time), following `inputs`,
+/// calling `row(t, values)` at each point with the outputs followed, when `with_states`,
+/// by the states.
 pub fn drive(
     sim: &mut Simulator,
     points: &[f64],
+    inputs: Option<&InputTable>,
     with_states: bool,
     mut row: impl FnMut(f64, &[f64]) -> Result<(), CliError>,
 ) -> Result<(), CliError> {
     let mut values = Vec::new();
     for (k, &t) in points.iter().enumerate() {
         if k > 0 {
-            sim.advance(t)?;
+            super::input_csv::advance(sim, inputs, t)?;
         }
         values.clear();
         values.extend(sim.outputs()?);
@@ -160,7 +167,14 @@ pub fn simulate(args: &SimulateArgs, stdout: &mut dyn Write) -> Result<(), CliEr
     let settings = RunSettings::resolve(&model, args.end, args.step, args.tol)?;
     let points = settings.points()?;
     let opts = SimOptions { tol: settings.tol, max_step: None };
+    let table = args.input.as_deref().map(|p| InputTable::read(p, &model)).transpose()?;
+    if let Some(t) = &table {
+        t.set_start(&mut model, settings.start);
+    }
     let mut sim = Simulator::new(&model, opts, settings.start)?;
+    if let Some(t) = &table {
+        t.apply(&mut sim)?;
+    }
 
     let (mut file_out, target) = match &args.out {
         Some(path) => {
@@ -180,7 +194,9 @@ pub fn simulate(args: &SimulateArgs, stdout: &mut dyn Write) -> Result<(), CliEr
     let io_err = |e| CliError::io(format!("writing {target}"), e);
 
     writeln!(out, "{}", header(&sim, args.states).join(",")).map_err(io_err)?;
-    let result = drive(&mut sim, &points, args.states, |t, values| write_csv_row(out, t, values).map_err(io_err));
+    let result = drive(&mut sim, &points, table.as_ref(), args.states, |t, values| {
+        write_csv_row(out, t, values).map_err(io_err)
+    });
     // Keep the rows computed before a failure: flush either way, report the first error.
     let flushed = out.flush().map_err(io_err);
     result.and(flushed)
