@@ -346,3 +346,15 @@ case!(
     "58_load_of_user_constraint.xml",
     "58_load_of_user_constraint.xml:4:27: output 'reaction': 'function' reads the load of a user constraint, which has no load"
 );
+
+case!(
+    m59_bad_unit,
+    "59_bad_unit.xml",
+    "59_bad_unit.xml:2:34: parameter 'c': attribute 'unit': 'Ns/m' is not a unit: 'Ns' is not a unit symbol (write factors joined by '.', e.g. 'N.s/m', 'kg.m2', 'm/s2')"
+);
+
+case!(
+    m60_bad_unit_exponent,
+    "60_bad_unit_exponent.xml",
+    "60_bad_unit_exponent.xml:2:19: input 'F': attribute 'unit': 'm^2' is not a unit: 'm^' is not a unit symbol (write factors joined by '.', e.g. 'N.s/m', 'kg.m2', 'm/s2')"
+);

@@ -63,6 +63,9 @@ def test_operating_point_values_are_the_fmu_values(packed):
     # At t = 0 the pendulum is upright (angle 0), so e = -r and force = kp e = -6.
     assert lin.y0 == pytest.approx([-6.0, 0.0], abs=1e-9)
     assert lin.x0.shape == (5,)
+    # Units come from the coordinates (dx -> m, ay -> rad) and their rates; xi has none.
+    assert lin.state_units == ["m", "rad", "m/s", "rad/s", ""]
+    assert lin.input_units == ["rad"] and lin.output_units == ["N", "rad"]
 
 
 def test_continue_a_host_simulation_then_linearize_the_instance(packed, tmp_path):

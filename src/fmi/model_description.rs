@@ -10,6 +10,7 @@
 //! `<analysis static="true"/>` the equilibrium positions depend on every input a force
 //! uses.
 
+use crate::model::units::{self, BASE_NAMES};
 use std::collections::BTreeSet;
 use std::fmt::Write as _;
 
@@ -110,13 +111,16 @@ fn write_units(x: &mut String, vars: &[Variable]) {
     x.push_str("  <UnitDefinitions>\n");
     for u in units {
         match base_unit(u) {
-            Some(exps) => {
+            Some((exps, factor)) => {
                 let _ = writeln!(x, "    <Unit name=\"{}\">", escape(u));
                 x.push_str("      <BaseUnit");
                 for (name, e) in BASE_NAMES.iter().zip(exps) {
                     if e != 0 {
                         let _ = write!(x, " {name}=\"{e}\"");
                     }
+                }
+                if factor != 1.0 {
+                    let _ = write!(x, " factor=\"{}\"", real(factor));
                 }
                 x.push_str("/>\n    </Unit>\n");
             }
@@ -128,51 +132,11 @@ fn write_units(x: &mut String, vars: &[Variable]) {
     x.push_str("  </UnitDefinitions>\n");
 }
 
-/// The SI base units of `<BaseUnit>`, in schema order.
-const BASE_NAMES: [&str; 8] = ["kg", "m", "s", "A", "K", "mol", "cd", "rad"];
-
-/// Exponents of a unit symbol, in [`BASE_NAMES`] order.
-fn symbol(s: &str) -> Option<[i32; 8]> {
-    Some(match s {
-        "kg" => [1, 0, 0, 0, 0, 0, 0, 0],
-        "m" => [0, 1, 0, 0, 0, 0, 0, 0],
-        "s" => [0, 0, 1, 0, 0, 0, 0, 0],
-        "A" => [0, 0, 0, 1, 0, 0, 0, 0],
-        "K" => [0, 0, 0, 0, 1, 0, 0, 0],
-        "mol" => [0, 0, 0, 0, 0, 1, 0, 0],
-        "cd" => [0, 0, 0, 0, 0, 0, 1, 0],
-        "rad" => [0, 0, 0, 0, 0, 0, 0, 1],
-        "N" => [1, 1, -2, 0, 0, 0, 0, 0],
-        "J" => [1, 2, -2, 0, 0, 0, 0, 0],
-        "W" => [1, 2, -3, 0, 0, 0, 0, 0],
-        "Pa" => [1, -1, -2, 0, 0, 0, 0, 0],
-        "Hz" => [0, 0, -1, 0, 0, 0, 0, 0],
-        _ => return None,
-    })
-}
-
-/// SI exponents of a unit in the FMI/Modelica syntax `N.m.s/rad`, `kg.m2`, `m/s2`
-/// (factors joined by `.`, at most one `/`, integer exponents); `None` if it uses
-/// anything else. Dimensionless units (all exponents 0) are `None` too.
-fn base_unit(unit: &str) -> Option<[i32; 8]> {
-    let (num, den) = match unit.split_once('/') {
-        Some((n, d)) => (n, Some(d)),
-        None => (unit, None),
-    };
-    let mut exps = [0i32; 8];
-    for (part, sign) in [(Some(num), 1), (den, -1)] {
-        let Some(part) = part else { continue };
-        for factor in part.split('.') {
-            let split = factor.find(|c: char| c.is_ascii_digit() || c == '-').unwrap_or(factor.len());
-            let (sym, pow) = factor.split_at(split);
-            let pow: i32 = if pow.is_empty() { 1 } else { pow.parse().ok()? };
-            let e = symbol(sym)?;
-            for (acc, b) in exps.iter_mut().zip(e) {
-                *acc += sign * pow * b;
-            }
-        }
-    }
-    exps.iter().any(|e| *e != 0).then_some(exps)
+/// SI exponents (in [`BASE_NAMES`] order) and factor of a unit; `None` for an unparsable
+/// or dimensionless one (no `<BaseUnit>` then).
+fn base_unit(unit: &str) -> Option<([i32; 8], f64)> {
+    let u = units::parse(unit).ok()?;
+    (u.exps.iter().any(|e| *e != 0)).then_some((u.exps, u.factor))
 }
 
 fn write_experiment(x: &mut String, model: &Model) {
@@ -356,16 +320,17 @@ mod tests {
 
     #[test]
     fn units_decompose_into_si_exponents() {
-        assert_eq!(base_unit("N.m"), Some([1, 2, -2, 0, 0, 0, 0, 0]));
-        assert_eq!(base_unit("N.m.s/rad"), Some([1, 2, -1, 0, 0, 0, 0, -1]));
-        assert_eq!(base_unit("kg.m2"), Some([1, 2, 0, 0, 0, 0, 0, 0]));
-        assert_eq!(base_unit("m/s2"), Some([0, 1, -2, 0, 0, 0, 0, 0]));
-        assert_eq!(base_unit("N.s/m"), Some([1, 0, -1, 0, 0, 0, 0, 0]));
-        assert_eq!(base_unit("mol"), Some([0, 0, 0, 0, 0, 1, 0, 0]));
+        assert_eq!(base_unit("N.m"), Some(([1, 2, -2, 0, 0, 0, 0, 0], 1.0)));
+        assert_eq!(base_unit("N.m.s/rad"), Some(([1, 2, -1, 0, 0, 0, 0, -1], 1.0)));
+        assert_eq!(base_unit("kg.m2"), Some(([1, 2, 0, 0, 0, 0, 0, 0], 1.0)));
+        assert_eq!(base_unit("m/s2"), Some(([0, 1, -2, 0, 0, 0, 0, 0], 1.0)));
+        assert_eq!(base_unit("N.s/m"), Some(([1, 0, -1, 0, 0, 0, 0, 0], 1.0)));
+        assert_eq!(base_unit("mol"), Some(([0, 0, 0, 0, 0, 1, 0, 0], 1.0)));
         assert_eq!(base_unit("furlong"), None);
         assert_eq!(base_unit("m/s/s"), None);
         assert_eq!(base_unit(""), None);
         assert_eq!(base_unit("m/m"), None);
+        assert_eq!(base_unit("mm"), Some(([0, 1, 0, 0, 0, 0, 0, 0], 1e-3)));
     }
 
     /// A slider with three inputs: `u` drives an sforce, `v` a gforce, `w` only an output.
@@ -377,7 +342,7 @@ mod tests {
   <joint name="j" type="translational" i="b.cm" j="ground.O"/>
   <input name="u" start="1.5" unit="N"/>
   <input name="v"/>
-  <input name="w" unit="furlong"/>
+  <input name="w" unit="1"/>
   <sforce name="f" type="translational" i="b.cm" j="ground.O" function="u*k"/>
   <gforce name="g" i="b.cm" force="0, 0, v" torque="0 0 0"/>
   <output name="pos" function="dz(b.cm)" unit="m"/>
@@ -412,11 +377,11 @@ mod tests {
         assert!(xml.contains(r#"<Real unit="N" start="1.5"/>"#));
         assert!(xml.contains(r#"description="mass &amp; more""#));
         assert!(xml.contains(r#"modelIdentifier="inputs""#));
-        assert!(xml.contains(r#"<Unit name="furlong"/>"#));
+        assert!(xml.contains(r#"<Unit name="1"/>"#));
         assert!(!xml.contains("<DefaultExperiment"));
         let units: Vec<&str> =
             xml.lines().filter_map(|l| l.trim().strip_prefix("<Unit name=\"")?.split('"').next()).collect();
-        assert_eq!(units, ["N", "furlong", "kg", "m", "m/s2"]);
+        assert_eq!(units, ["1", "N", "kg", "m", "m/s2"]);
     }
 
     #[test]
@@ -430,7 +395,7 @@ mod tests {
     }
 
     #[test]
-    fn a_model_without_outputs_or_units_lists_only_its_states() {
+    fn a_model_without_outputs_or_units_lists_its_states_with_coordinate_units() {
         let text = r#"<multibody name="bare" version="1">
   <parameter name="m" value="2"/>
   <body name="b" mass="m" inertia="1 1 1" position="0 0 0"/>
@@ -440,7 +405,14 @@ mod tests {
         // A free body: six internal states, their velocities and accelerations.
         assert!(xml.contains(r#"name="b.x""#) && xml.contains(r#"name="der(b.phi,2)""#), "{xml}");
         assert!(xml.contains("<Derivatives>"), "{xml}");
-        assert!(!xml.contains("UnitDefinitions") && !xml.contains("<Outputs"), "{xml}");
+        assert!(!xml.contains("<Outputs"), "{xml}");
+        // The states carry the units of their coordinates (the model declares none).
+        for (var, unit) in [("b.x", "m"), ("b.phi", "rad"), ("der(b.x)", "m/s"), ("der(b.phi,2)", "rad/s2")] {
+            let at = xml.find(&format!("name=\"{var}\"")).unwrap_or_else(|| panic!("{var}"));
+            let real = &xml[at..at + xml[at..].find("</ScalarVariable>").unwrap()];
+            assert!(real.contains(&format!("unit=\"{unit}\"")), "{var}: {real}");
+        }
+        assert!(xml.contains(r#"<Unit name="rad/s2">"#), "{xml}");
     }
 
     #[test]

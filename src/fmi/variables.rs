@@ -8,6 +8,7 @@
 //! with them, so both always agree.
 
 use crate::model::Model;
+use crate::model::units::per_second;
 
 /// FMI causality of a variable.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -70,6 +71,10 @@ pub struct StateLayout {
     pub s: Vec<String>,
     pub w: Vec<String>,
     pub w_of: Vec<Option<usize>>,
+    /// Units of S and W (from the coordinate: m, rad, m/s, rad/s; none for a general
+    /// expression).
+    pub s_units: Vec<Option<String>>,
+    pub w_units: Vec<Option<String>>,
 }
 
 impl StateLayout {
@@ -141,6 +146,7 @@ pub fn variables(model: &Model) -> Vec<Variable> {
     let first_s = v.len();
     for (k, name) in lay.s.iter().enumerate() {
         let mut x = var(name.clone(), v.len(), Target::State(k));
+        x.unit = lay.s_units[k].clone();
         x.description = Some("linearization state (seed Eq. 33)".into());
         x.known = Some(k);
         v.push(x);
@@ -148,6 +154,7 @@ pub fn variables(model: &Model) -> Vec<Variable> {
     let first_sd = v.len();
     for (k, name) in lay.s.iter().enumerate() {
         let mut x = var(format!("der({name})"), v.len(), Target::StateDerivative(k));
+        x.unit = lay.s_units[k].as_deref().and_then(per_second);
         x.derivative = Some(first_s + k + 1);
         x.known = lay.w_for(k).map(|j| s0 + j);
         x.unknown = Some(k);
@@ -162,6 +169,7 @@ pub fn variables(model: &Model) -> Vec<Variable> {
     }
     for j in (0..s1).filter(|&j| lay.w_of[j].is_none()) {
         let mut x = var(lay.w[j].clone(), v.len(), Target::Velocity(j));
+        x.unit = lay.w_units[j].clone();
         x.description = Some("velocity state (non-holonomic model)".into());
         x.known = Some(s0 + j);
         w_index[j] = v.len() + 1;
@@ -173,6 +181,7 @@ pub fn variables(model: &Model) -> Vec<Variable> {
             None => format!("der({})", lay.w[j]),
         };
         let mut x = var(name, v.len(), Target::VelocityDerivative(j));
+        x.unit = lay.w_units[j].as_deref().and_then(per_second);
         x.derivative = Some(wi);
         x.unknown = Some(s0 + j);
         v.push(x);
@@ -205,5 +214,7 @@ pub fn state_layout(model: &Model) -> StateLayout {
     let s: Vec<String> = sel.states.iter().map(|x| x.name.clone()).collect();
     let w: Vec<String> = sel.velocities.iter().map(|x| x.name()).collect();
     let w_of = w.iter().map(|n| s.iter().position(|sn| format!("der({sn})") == *n)).collect();
-    StateLayout { s, w, w_of }
+    let s_units = sel.states.iter().map(|x| x.unit()).collect();
+    let w_units = sel.velocities.iter().map(|x| x.unit()).collect();
+    StateLayout { s, w, w_of, s_units, w_units }
 }

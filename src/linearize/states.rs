@@ -149,3 +149,25 @@ pub fn internal_state(sys: &System, i: usize) -> StateFn {
     let kind = if k < 3 { StateKind::Position { k } } else { StateKind::Angle { k: k - 3, r0: sys.r0[b] } };
     StateFn { name: format!("{}.{}", sys.bodies[b].name, names[k]), kind, bodies: vec![b] }
 }
+
+impl StateFn {
+    /// The state's unit: m for a CM coordinate, rad for an angle, that of the kinematic
+    /// measure a user state is (none for other expressions).
+    pub fn unit(&self) -> Option<String> {
+        match &self.kind {
+            StateKind::Position { .. } => Some("m".into()),
+            StateKind::Angle { .. } => Some("rad".into()),
+            StateKind::User { f, .. } => crate::model::units::of_expr(f).map(str::to_string),
+        }
+    }
+}
+
+impl VelState {
+    /// The velocity state's unit (that of Ṡ, or of the user's velocity expression).
+    pub fn unit(&self) -> Option<String> {
+        match self {
+            VelState::Derivative(s) => s.unit().and_then(|u| crate::model::units::per_second(&u)),
+            VelState::User(u) => crate::model::units::of_expr(&u.f).map(str::to_string),
+        }
+    }
+}

@@ -5,6 +5,7 @@ pub mod error;
 pub mod expr;
 pub mod parse;
 mod types;
+pub mod units;
 
 pub use error::ModelError;
 pub use parse::{Summary, load_file, load_str, rotation, try_rotation};

@@ -92,6 +92,13 @@ impl<'a> El<'a> {
     pub fn get(&self, name: &str) -> Option<&'a XAttr> {
         self.x.attr(name)
     }
+    /// The optional `unit` attribute, checked against the unit grammar
+    /// ([`crate::model::units`]); an error points at the attribute.
+    pub fn unit(&self) -> Result<Option<String>, ModelError> {
+        let Some(a) = self.get("unit") else { return Ok(None) };
+        crate::model::units::parse(&a.value).map_err(|e| self.err_at(a.pos, format!("attribute 'unit': {e}")))?;
+        Ok(Some(a.value.clone()))
+    }
     /// Attribute `name`, required.
     pub fn req(&self, name: &str) -> Result<&'a XAttr, ModelError> {
         self.get(name).ok_or_else(|| self.err(format!("missing required attribute '{name}'")))

@@ -150,23 +150,14 @@ impl<'a> Loader<'a> {
                     });
                 }
                 "input" => {
-                    let input = Input {
-                        name: x.label().into(),
-                        start: el.num_or("start", 0.0)?,
-                        unit: el.get("unit").map(|a| a.value.clone()),
-                        pos: x.pos,
-                    };
+                    let input =
+                        Input { name: x.label().into(), start: el.num_or("start", 0.0)?, unit: el.unit()?, pos: x.pos };
                     self.model.inputs.push(input);
                 }
                 "output" => {
                     let function = el.expr_req("function")?;
                     check_deps(&el, "function", &function, Allowed::Any)?;
-                    self.model.outputs.push(Output {
-                        name: x.label().into(),
-                        function,
-                        unit: el.get("unit").map(|a| a.value.clone()),
-                        pos: x.pos,
-                    });
+                    self.model.outputs.push(Output { name: x.label().into(), function, unit: el.unit()?, pos: x.pos });
                 }
                 "linearization" => self.linearization(x)?,
                 "experiment" => {

@@ -132,7 +132,7 @@ impl<'a> Loader<'a> {
             self.model.parameters.push(Parameter {
                 name: x.label().to_string(),
                 value: Num { expr: e, value: *v },
-                unit: el.get("unit").map(|a| a.value.clone()),
+                unit: el.unit()?,
                 description: el.get("description").map(|a| a.value.clone()),
                 pos: x.pos,
             });
