@@ -172,3 +172,42 @@ fn a_missing_library_is_a_clear_error() {
     assert!(text(&o.stderr).contains("MBFMU_LIB="), "{}", text(&o.stderr));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn installed_mbfmu_packs_from_any_directory_with_no_environment() {
+    // `mbfmu install --prefix P` writes P/bin/mbfmu with the FMU library embedded; run from
+    // an empty directory without MBFMU_LIB, it packs an FMU whose binary is that library.
+    let root = std::env::temp_dir().join(format!("mbfmu-install-{}", std::process::id()));
+    let (prefix, empty) = (root.join("prefix"), root.join("empty"));
+    std::fs::create_dir_all(&empty).unwrap();
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_mbfmu"))
+        .args(["install", "--prefix", prefix.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let installed = prefix.join("bin").join("mbfmu");
+    let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("models/pendulum.xml");
+    std::fs::copy(&model, empty.join("pendulum.xml")).unwrap();
+    let pack = |exe: &Path| {
+        let o = std::process::Command::new(exe)
+            .args(["pack", "pendulum.xml", "-o", "p.fmu", "--out-dir", "p"])
+            .current_dir(&empty)
+            .env_remove("MBFMU_LIB")
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        std::fs::read(empty.join("p/binaries").join(mbfmu::fmi::pack::PLATFORM).join("pendulum.so")).unwrap()
+    };
+    let lib = mbfmu::fmi::pack::library().unwrap();
+    assert_eq!(pack(&installed), lib);
+    // Installing from the installed copy embeds the library once, not twice.
+    let again = root.join("again");
+    let o =
+        std::process::Command::new(&installed).args(["install", "--prefix", again.to_str().unwrap()]).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (a, b) =
+        (std::fs::metadata(&installed).unwrap().len(), std::fs::metadata(again.join("bin/mbfmu")).unwrap().len());
+    assert_eq!(a, b);
+    assert_eq!(pack(&again.join("bin/mbfmu")), lib);
+    std::fs::remove_dir_all(&root).ok();
+}

@@ -8,6 +8,7 @@
 mod check;
 mod error;
 mod input_csv;
+mod install;
 mod linearize;
 mod matrices;
 mod pack;
@@ -50,6 +51,9 @@ pub enum Command {
     /// Linearize a model at one or more times: chosen states, eigenvalue table, and A, B,
     /// C, D as json, npz or mat.
     Linearize(LinearizeArgs),
+    /// Install this mbfmu with the FMU library embedded as PREFIX/bin/mbfmu (default
+    /// PREFIX: ~/.local), so that `mbfmu pack` works from anywhere.
+    Install(install::InstallArgs),
     /// Run the embedded default model (models/double_pendulum.xml) for 2 s and print a
     /// table of its outputs.
     Run,
@@ -98,6 +102,7 @@ pub fn execute(command: &Command) -> Result<(), CliError> {
         Command::Simulate(args) => simulate::simulate(args, &mut out),
         Command::Pack(args) => pack::run(args, &mut out),
         Command::Linearize(args) => linearize::run(args, &mut out, &mut std::io::stderr().lock()),
+        Command::Install(args) => install::run(args, &mut out),
         Command::Run => run::run(&mut out),
     }
 }

@@ -2,6 +2,7 @@
 //! references, enforces the FMI state machine, logs, and calls the engine; it computes
 //! nothing itself.
 
+pub mod bundle;
 pub mod dependencies;
 pub mod exports_common;
 pub mod exports_cs;

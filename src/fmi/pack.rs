@@ -7,7 +7,8 @@
 //! ```
 //!
 //! The cdylib is found through the environment variable `MBFMU_LIB` (a file path), else
-//! next to the running executable (see [`find_library`]).
+//! inside the running executable (an installed `mbfmu`, see [`super::bundle`]), else next
+//! to it (a cargo build, see [`find_library`]).
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -105,10 +106,24 @@ pub fn find_library() -> Result<PathBuf, PackError> {
     match newest {
         Some((_, p)) => Ok(p.clone()),
         None => Err(PackError::LibraryNotFound(format!(
-            "the FMU library {name} was not found (tried {}); build it with `cargo build --release` or set MBFMU_LIB",
+            "the FMU library {name} was not found (tried {}); build it with `cargo build --release` \
+             and install mbfmu with `target/release/mbfmu install` (README), or set MBFMU_LIB",
             candidates.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ")
         ))),
     }
+}
+
+/// The FMU library's bytes: `MBFMU_LIB` if set, else the copy embedded in the running
+/// executable by `mbfmu install` ([`super::bundle`]), else the cdylib of the build the
+/// executable comes from ([`find_library`]).
+pub fn library() -> Result<Vec<u8>, PackError> {
+    if std::env::var_os("MBFMU_LIB").is_none()
+        && let Some(lib) = super::bundle::embedded_library()
+    {
+        return Ok(lib);
+    }
+    let path = find_library()?;
+    std::fs::read(&path).map_err(io_err(format!("reading {}", path.display())))
 }
 
 /// Load the model and gather every file of its FMU.
@@ -130,8 +145,7 @@ fn contents(model_path: &Path) -> Result<Contents, PackError> {
     })?;
     let model = load_str(text, &label)?;
     let id = model_identifier(&model.name);
-    let lib_path = find_library()?;
-    let lib = std::fs::read(&lib_path).map_err(io_err(format!("reading {}", lib_path.display())))?;
+    let lib = library()?;
     let xml = model_description::write(&model, text);
     let files = vec![
         ("modelDescription.xml".to_string(), xml.into_bytes()),
