@@ -16,6 +16,7 @@ pub fn check(path: &Path, out: &mut dyn Write) -> Result<(), CliError> {
     let t0 = model.experiment.start.unwrap_or(0.0);
     let sim =
         Simulator::new(&model, SimOptions { tol: model.experiment.tolerance.unwrap_or(1e-8), max_step: None }, t0)?;
+    super::print_warnings(&sim);
     let c = counts(sim.system(), sim.q(), sim.u(), t0, &sim.inputs(), &sim.ext());
     writeln!(out, "model '{}' ({}): ok", model.name, path.display())
         .and_then(|()| write!(out, "{}", report(model.bodies.len(), &c)))

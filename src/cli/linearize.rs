@@ -71,6 +71,7 @@ pub fn run(args: &LinearizeArgs, out: &mut dyn Write, report: &mut dyn Write) ->
     if let Some(t) = &table {
         t.apply(&mut sim)?;
     }
+    super::print_warnings(&sim);
     let sel = select_states(sim.system(), sim.q(), t0, &sim.inputs()).map_err(|e| CliError::Engine(e.into()))?;
     let io_err = |e| CliError::io("writing output", e);
     let json_stdout = args.format == "json" && args.out.is_none();

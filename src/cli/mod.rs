@@ -93,6 +93,13 @@ pub fn main() -> ExitCode {
     }
 }
 
+/// Print the engine's initialization warnings (bodies that assembly moved far) to stderr.
+pub(crate) fn print_warnings(sim: &crate::dae::Simulator) {
+    for w in sim.warnings() {
+        eprintln!("warning: {w}");
+    }
+}
+
 /// Run one command, writing its normal output to stdout.
 pub fn execute(command: &Command) -> Result<(), CliError> {
     let stdout = std::io::stdout();

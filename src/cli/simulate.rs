@@ -175,6 +175,7 @@ pub fn simulate(args: &SimulateArgs, stdout: &mut dyn Write) -> Result<(), CliEr
     if let Some(t) = &table {
         t.apply(&mut sim)?;
     }
+    super::print_warnings(&sim);
 
     let (mut file_out, target) = match &args.out {
         Some(path) => {

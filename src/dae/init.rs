@@ -87,14 +87,22 @@ pub fn assemble_positions(sys: &System, q: &mut [f64], t: f64, inputs: &[f64], t
             return Ok(());
         }
         if lu.factor(n + mr, &kkt).is_err() {
-            return Err(at_row(&els, worst.0, redundant(worst.1)));
+            return Err(at_row(
+                &els,
+                worst.0,
+                format!("{}; equations not met: {}", redundant(worst.1), unmet(sys, &els, &c, tol * scale, t, inputs)),
+            ));
         }
         let mut rhs = vec![0.0; n + mr];
         for (i, v) in c.iter().enumerate() {
             rhs[n + i] = if i < sys.m && sys.redundant[i] { 0.0 } else { -v };
         }
         if !lu.solve(&mut rhs) {
-            return Err(at_row(&els, worst.0, redundant(worst.1)));
+            return Err(at_row(
+                &els,
+                worst.0,
+                format!("{}; equations not met: {}", redundant(worst.1), unmet(sys, &els, &c, tol * scale, t, inputs)),
+            ));
         }
         for i in 0..n {
             q[i] += rhs[i];
@@ -102,15 +110,52 @@ pub fn assemble_positions(sys: &System, q: &mut [f64], t: f64, inputs: &[f64], t
         last = worst.1;
     }
     let _ = last;
-    // Report the worst constraint after the iterations.
+    // Report the worst constraint after the iterations, and every element not met.
     eval_set(sys, &els, q, t, inputs, &mut c);
     let worst =
         c.iter().enumerate().fold((0, 0.0f64), |(k, w), (i, v)| if v.abs() > w { (i, v.abs()) } else { (k, w) });
     Err(at_row(
         &els,
         worst.0,
-        format!("cannot be assembled: worst constraint residual {:.3e} after 100 iterations", worst.1),
+        format!(
+            "cannot be assembled: worst constraint residual {:.3e} after 100 iterations; equations not met: {}",
+            worst.1,
+            unmet(sys, &els, &c, tol * scale, t, inputs)
+        ),
     ))
+}
+
+/// The elements whose equations are not met (some |C_i| above `limit`), worst first, with
+/// their largest residual and, for two-marker elements, how far apart their markers are
+/// in the model as written (its initial positions).
+fn unmet(sys: &System, els: &[ConstraintEl], c: &[f64], limit: f64, t: f64, inputs: &[f64]) -> String {
+    use crate::mechanics::constraints::ConstraintKind;
+    use crate::model::expr::{Expr, KinFn};
+    let mut bad: Vec<(f64, &ConstraintEl)> = els
+        .iter()
+        .map(|e| (c[e.row..e.row + e.neq].iter().fold(0.0f64, |a, v| a.max(v.abs())), e))
+        .filter(|(r, _)| *r > limit)
+        .collect();
+    bad.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let ids: Vec<usize> = (0..sys.nb()).collect();
+    let zeros = vec![0.0; sys.n()];
+    let ctx = LocalCtx::new(sys, &ids, &sys.q_init, &zeros, &zeros, t, inputs);
+    bad.iter()
+        .map(|(r, e)| {
+            let markers = match &e.kind {
+                ConstraintKind::Joint { i, j, .. }
+                | ConstraintKind::Rotation { i, j, .. }
+                | ConstraintKind::Translation { i, j, .. } => Some((*i, *j)),
+                _ => None,
+            };
+            let gap = markers
+                .map(|(i, j)| ctx.eval_expr(&Expr::Kin(KinFn::Dm, i, Some(j), None), 0))
+                .filter(|d: &f64| d.is_finite())
+                .map_or(String::new(), |d| format!(", markers {d:.3e} m apart as written"));
+            format!("{} '{}' (residual {r:.3e}{gap})", e.tag, e.name)
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// Message for a singular assembly step.

@@ -246,6 +246,11 @@ impl MultibodyDae {
     }
 }
 
+/// Assembly moving a body's CM by more than this fraction of the model's size (the
+/// diagonal of the box around the initial CM positions and the ground origin, at least
+/// 1 m) is reported: the geometry as written is probably not the mechanism meant.
+pub const ASSEMBLY_MOVE_FRACTION: f64 = 0.01;
+
 /// A running simulation of one model.
 pub struct Simulator {
     dae: MultibodyDae,
@@ -253,6 +258,35 @@ pub struct Simulator {
     acc_lu: SparseLu,
     /// Accelerations and multipliers at the current time (None: not yet computed).
     acc: Option<(Vec<f64>, Vec<f64>)>,
+    /// What initialization wants the user to know (bodies that assembly moved far).
+    warnings: Vec<String>,
+}
+
+/// Bodies whose CM assembly moved by more than [`ASSEMBLY_MOVE_FRACTION`] of the model's
+/// size, as messages naming the body and the distance.
+fn assembly_moves(model: &Model, q0: &[f64], q: &[f64]) -> Vec<String> {
+    let cm = |q: &[f64], b: usize| [q[NQ * b], q[NQ * b + 1], q[NQ * b + 2]];
+    let (mut lo, mut hi) = ([0.0f64; 3], [0.0f64; 3]);
+    for b in 0..model.bodies.len() {
+        for (k, x) in cm(q0, b).into_iter().enumerate() {
+            lo[k] = lo[k].min(x);
+            hi[k] = hi[k].max(x);
+        }
+    }
+    let size = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt().max(1.0);
+    (0..model.bodies.len())
+        .filter_map(|b| {
+            let (a, z) = (cm(q0, b), cm(q, b));
+            let d = (0..3).map(|k| (z[k] - a[k]).powi(2)).sum::<f64>().sqrt();
+            (d > ASSEMBLY_MOVE_FRACTION * size).then(|| {
+                format!(
+                    "assembly moved body '{}' by {d:.3e} m (more than {} of the model's size {size:.3e} m): \
+                     the initial geometry may not be the mechanism meant",
+                    model.bodies[b].name, ASSEMBLY_MOVE_FRACTION
+                )
+            })
+        })
+        .collect()
 }
 
 impl Simulator {
@@ -276,6 +310,7 @@ impl Simulator {
             }),
             None => EngineError::Numeric(e.msg),
         })?;
+        let (sys_q0, assembled) = (sys.q_init.clone(), q.clone());
         let mut z = vec![0.0; lay.nz()];
         z[..lay.nx].copy_from_slice(&sys.x_init);
         if model.static_analysis {
@@ -299,7 +334,8 @@ impl Simulator {
         if let Some(h) = opts.max_step {
             radau.max_step = h;
         }
-        Ok(Simulator { dae, radau, acc_lu, acc: Some((udot, lam)) })
+        let warnings = assembly_moves(model, &sys_q0, &assembled);
+        Ok(Simulator { dae, radau, acc_lu, acc: Some((udot, lam)), warnings })
     }
 
     /// Current time.
@@ -596,6 +632,11 @@ impl Simulator {
         self.dae.inputs[i] = v;
         self.dae.slopes[i] = 0.0;
         self.acc = None;
+    }
+
+    /// Warnings of initialization (bodies that assembly moved far), for the user.
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
     }
 
     /// Re-solve, at the current point, the unknowns that follow the inputs at once: the

@@ -119,7 +119,11 @@ impl Instance {
     /// missing or the values changed before initialization ended.
     pub fn simulator(&mut self) -> Result<&mut Simulator, String> {
         if self.built.is_none() || self.dirty {
-            self.built = Some(self.build(&self.config.clone())?);
+            let built = self.build(&self.config.clone())?;
+            for w in built.sim.warnings() {
+                self.log.log(Status::Warning, &format!("initialization: {w}"));
+            }
+            self.built = Some(built);
             self.dirty = false;
         }
         Ok(&mut self.built.as_mut().expect("just built").sim)

@@ -136,3 +136,22 @@ def test_a_state_of_another_fmu_or_garbage_is_refused(logged, packed):
     s.freeFMUstate(own)
     s.freeFMUstate(restored)
     s.doStep(0.0, 0.1)
+
+
+def test_assembly_that_moves_a_body_far_is_logged_as_a_warning(tmp_path):
+    # The FMU logger tells the host what `mbfmu check` prints: a 0.2 m typo in rod2's
+    # position is assembled away, and the instance logs which body moved and how far.
+    from fmu_helpers import MODELS, LogCapture, initialize, new_slave, pack_model
+
+    text = (MODELS / "double_pendulum.xml").read_text().replace(
+        'position="-L*sin(th1) - L/2*sin(th2), 0,', 'position="0.2 - L*sin(th1) - L/2*sin(th2), 0,')
+    model = tmp_path / "double_pendulum_typo.xml"
+    model.write_text(text)
+    p = pack_model(model, tmp_path)
+    log = LogCapture()
+    s = new_slave(p, log=log, logging_on=True)
+    initialize(s, tol=1e-8)
+    warnings = [m for m in log.messages(status=1) if "assembly moved body 'rod2' by " in m]
+    assert warnings, log.records
+    s.terminate()
+    s.freeInstance()
