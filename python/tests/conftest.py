@@ -32,25 +32,10 @@ def packed(tmp_path_factory):
     return get
 
 
-def cli_linearize(model: Path, at: list[float], tol: float, out: Path) -> list[dict]:
-    """`mbfmu linearize MODEL --at ... --tol TOL --format json -o OUT`, parsed."""
-    r = subprocess.run(
-        [
-            str(cli()),
-            "linearize",
-            str(model),
-            "--at",
-            ",".join(repr(t) for t in at),
-            "--tol",
-            repr(tol),
-            "--format",
-            "json",
-            "-o",
-            str(out),
-        ],
-        capture_output=True,
-        text=True,
-    )
+def cli_linearize(model: Path, at: list[float], tol: float, out: Path, *extra: str) -> list[dict]:
+    """`mbfmu linearize MODEL --at ... --tol TOL [EXTRA...] --format json -o OUT`, parsed."""
+    args = [str(cli()), "linearize", str(model), "--at", ",".join(repr(t) for t in at), "--tol", repr(tol), *extra]
+    r = subprocess.run([*args, "--format", "json", "-o", str(out)], capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
     return json.loads(out.read_text())
 

@@ -124,34 +124,11 @@ def test_cli_input_file_and_package_inputs_give_the_same_linearization(packed, t
     # called directly) and mbfmu.linearize(inputs=...) (fmpy sets values and slopes at
     # the rows) follow the same piecewise-linear signal: same A, B, C, D (1e-9) at a
     # moving point, and the operating point's r is the interpolated value.
-    import subprocess
-
-    from mbfmu.pack import cli
-
     rows = [(0.0, 0.0), (0.4, 0.2), (1.0, -0.1)]
     csv = tmp_path / "r.csv"
     csv.write_text("time,r\n" + "".join(f"{t!r},{r!r}\n" for t, r in rows))
     out = tmp_path / "lin.json"
-    r = subprocess.run(
-        [
-            str(cli()),
-            "linearize",
-            str(MODELS / "cart_pendulum_pid.xml"),
-            "--at",
-            "0.7",
-            "--tol",
-            "1e-9",
-            "--input",
-            str(csv),
-            "--format",
-            "json",
-            "-o",
-            str(out),
-        ],
-        capture_output=True,
-        text=True,
-    )
-    assert r.returncode == 0, r.stderr
+    cli_linearize(MODELS / "cart_pendulum_pid.xml", [0.7], 1e-9, out, "--input", str(csv))
     (ref,) = mbfmu.load(out)
     sig = np.array(rows, dtype=[("time", float), ("r", float)])
     (lin,) = mbfmu.linearize(packed("cart_pendulum_pid"), at=0.7, inputs=sig, tolerance=1e-9)
