@@ -163,3 +163,26 @@ fn a_closed_pipe_ends_quietly() {
     assert!(o.status.success(), "exit {:?}: {}", o.status, String::from_utf8_lossy(&o.stderr));
     assert!(o.stderr.is_empty(), "{}", String::from_utf8_lossy(&o.stderr));
 }
+
+#[test]
+fn automatic_states_are_named_after_joints_in_the_cli_output() {
+    // spring_mass_damper.xml has no <linearization>: its one state is the guide's
+    // displacement x, so A = [[0, 1], [−k/m, −c/m]] = [[0, 1], [−100, −2]] exactly (its
+    // file comment: m x'' + c x' + k x = 0); 1e-9 leaves room for the sparse solve only.
+    let o = mbfmu(&["linearize", "models/spring_mass_damper.xml", "--format", "json"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let json = String::from_utf8_lossy(&o.stdout);
+    assert!(json.contains(r#""guide.displacement""#) && json.contains(r#""der(guide.displacement)""#), "{json}");
+    let start = json.find("\"A\": [[").unwrap() + 7;
+    let a: Vec<f64> = json[start..]
+        .split(']')
+        .take(2)
+        .flat_map(|r| {
+            r.trim_start_matches([',', ' ', '[']).split(',').filter_map(|x| x.trim().parse().ok()).collect::<Vec<f64>>()
+        })
+        .collect();
+    let want = [0.0, 1.0, -100.0, -2.0];
+    assert!(a.len() == 4 && a.iter().zip(want).all(|(x, y)| (x - y).abs() < 1e-9), "{a:?}");
+    let report = String::from_utf8_lossy(&o.stderr);
+    assert!(report.contains("linearization states (1): guide.displacement"), "{report}");
+}

@@ -87,9 +87,10 @@ fn variables(xml: &str) -> Vec<(usize, String, String)> {
 fn two_separate_pendulums_get_separate_dependency_lists() {
     let model = load_str(TWIN, "twin.xml").unwrap_or_else(|e| panic!("{e}"));
     let xml = write(&model, TWIN);
-    // Indices: T 1, U 2, outputs 3..10, states a.? 11, b.? 12, der() 13 14, der(,2) 15 16.
+    // Indices: T 1, U 2, outputs 3..10, states ha.angle 11, hb.angle 12, der() 13 14,
+    // der(,2) 15 16.
     let names: Vec<String> = variables(&xml).into_iter().map(|v| v.1).collect();
-    assert!(names[10].starts_with("a.") && names[11].starts_with("b."), "{names:?}");
+    assert_eq!(names[10..12], ["ha.angle", "hb.angle"], "{names:?}");
     let outputs = section(&xml, "Outputs");
     let want: [(usize, &[usize]); 8] = [
         (3, &[11, 13]),    // ya: positions of a

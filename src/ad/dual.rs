@@ -114,6 +114,9 @@ impl<T: Real, const N: usize> Real for Dual<T, N> {
     fn val(&self) -> f64 {
         self.v.val()
     }
+    fn tangent(&self) -> f64 {
+        self.d.first().map_or(0.0, |x| x.val())
+    }
     fn scale(self, s: f64) -> Self {
         let mut d = self.d;
         for x in d.iter_mut() {

@@ -47,6 +47,10 @@ pub trait Real:
     fn pow(self, y: Self) -> Self;
     /// True when no derivative is carried at any nesting level.
     fn is_constant(&self) -> bool;
+    /// The first derivative component's value (0 for a plain number).
+    fn tangent(&self) -> f64 {
+        0.0
+    }
     /// Zero.
     fn zero() -> Self {
         Self::cst(0.0)

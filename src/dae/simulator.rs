@@ -4,6 +4,7 @@ use super::equations::{self, Layout};
 use super::init;
 use super::radau::{DaeProblem, Radau, Stats};
 use super::sparse::{SparseLu, Triplets};
+use crate::ad::Real;
 use crate::geom::{M3, V3, rot313};
 use crate::mechanics::System;
 use crate::mechanics::body::{NQ, body_frame};
@@ -70,8 +71,11 @@ pub struct SimState {
     pub y: Vec<f64>,
     /// Euler-angle reference frames.
     pub r0: Vec<[[f64; 3]; 3]>,
-    /// Angle-unwrapping references of expressions and rotational springs.
+    /// Angle-unwrapping references of expressions (values, rates, their time) and of
+    /// rotational springs.
     pub angle_refs: Vec<f64>,
+    pub angle_rates: Vec<f64>,
+    pub angle_time: f64,
     pub spring_refs: Vec<f64>,
     pub inputs: Vec<f64>,
     pub slopes: Vec<f64>,
@@ -80,7 +84,7 @@ pub struct SimState {
     pub integrator: Vec<f64>,
 }
 
-const STATE_MAGIC: &[u8; 8] = b"MBFMUS01";
+const STATE_MAGIC: &[u8; 8] = b"MBFMUS02";
 
 impl SimState {
     /// Serialize (little-endian f64 arrays with lengths, behind a magic tag).
@@ -92,10 +96,11 @@ impl SimState {
                 b.extend_from_slice(&x.to_le_bytes());
             }
         };
-        arr(&[self.t, self.h, self.t_in]);
+        arr(&[self.t, self.h, self.t_in, self.angle_time]);
         arr(&self.y);
         arr(&self.r0.iter().flatten().flatten().copied().collect::<Vec<f64>>());
         arr(&self.angle_refs);
+        arr(&self.angle_rates);
         arr(&self.spring_refs);
         arr(&self.inputs);
         arr(&self.slopes);
@@ -120,8 +125,9 @@ impl SimState {
         let head = arr()?;
         let y = arr()?;
         let r0f = arr()?;
-        let (angle_refs, spring_refs, inputs, slopes, integrator) = (arr()?, arr()?, arr()?, arr()?, arr()?);
-        if head.len() != 3 || r0f.len() % 9 != 0 || pos != rest.len() {
+        let (angle_refs, angle_rates) = (arr()?, arr()?);
+        let (spring_refs, inputs, slopes, integrator) = (arr()?, arr()?, arr()?, arr()?);
+        if head.len() != 4 || angle_rates.len() != angle_refs.len() || r0f.len() % 9 != 0 || pos != rest.len() {
             return Err(bad());
         }
         let r0 = r0f.chunks_exact(9).map(|c| [[c[0], c[1], c[2]], [c[3], c[4], c[5]], [c[6], c[7], c[8]]]).collect();
@@ -129,9 +135,11 @@ impl SimState {
             t: head[0],
             h: head[1],
             t_in: head[2],
+            angle_time: head[3],
             y,
             r0,
             angle_refs,
+            angle_rates,
             spring_refs,
             inputs,
             slopes,
@@ -208,7 +216,9 @@ impl MultibodyDae {
         self.inputs.iter().zip(&self.slopes).map(|(v, s)| v + s * (t - self.t_in)).collect()
     }
 
-    /// Store the current value of every angle measure, so expressions stay on its branch.
+    /// Store the current value and rate of every angle measure, so expressions stay on
+    /// its branch. Rates come from one evaluation with scalars seeded along the motion
+    /// (q̇ = H(q) u, ṫ = 1; angle measures depend on positions only).
     fn record_angles(&mut self, t: f64, q: &[f64], u: &[f64], inputs: &[f64]) {
         if self.sys.angle_refs.is_empty() {
             return;
@@ -217,13 +227,20 @@ impl MultibodyDae {
         {
             let sys = &self.sys;
             let ids: Vec<usize> = (0..sys.nb()).collect();
-            let mut ctx = LocalCtx::new(sys, &ids, q, u, &[], t, inputs);
+            type D1 = crate::ad::Dual<f64, 1>;
+            let mut qd: Vec<D1> = Vec::with_capacity(q.len());
+            for (qb, ub) in q.chunks_exact(NQ).zip(u.chunks_exact(NQ)) {
+                let rate = crate::mechanics::body::qdot(qb, ub);
+                qd.extend(qb.iter().zip(rate).map(|(&v, d)| D1 { v, d: [d] }));
+            }
+            let ud: Vec<D1> = u.iter().map(|&v| D1::cst(v)).collect();
+            let mut ctx = LocalCtx::new(sys, &ids, &qd, &ud, &[], D1 { v: t, d: [1.0] }, inputs);
             ctx.record = Some(&rec);
             for ue in &sys.user {
                 ue.residual(&ctx);
             }
             for el in &sys.constraints {
-                let mut out = vec![0.0; el.neq];
+                let mut out = vec![D1::zero(); el.neq];
                 el.kind.eval(&ctx, &mut out);
             }
             for el in &sys.forces {
@@ -235,14 +252,19 @@ impl MultibodyDae {
             for (_, e, b) in sys.lin_states.iter().chain(&sys.lin_velocities) {
                 ctx.eval_expr(e, *b);
             }
+            for c in &sys.joint_coords {
+                ctx.eval_expr(&c.f, c.abase);
+            }
             for el in &sys.nonholonomic {
-                let mut out = vec![0.0; el.neq];
+                let mut out = vec![D1::zero(); el.neq];
                 el.kind.eval(&ctx, &mut out);
             }
         }
-        for (g, v) in rec.into_inner() {
+        for (g, v, rate) in rec.into_inner() {
             self.sys.angle_refs[g] = v;
+            self.sys.angle_rates[g] = rate;
         }
+        self.sys.angle_time = t;
     }
 }
 
@@ -505,6 +527,8 @@ impl Simulator {
             y: self.radau.y.clone(),
             r0: self.dae.sys.r0.clone(),
             angle_refs: self.dae.sys.angle_refs.clone(),
+            angle_rates: self.dae.sys.angle_rates.clone(),
+            angle_time: self.dae.sys.angle_time,
             spring_refs: self.dae.sys.forces.iter().map(|f| f.angle_ref).collect(),
             inputs: self.dae.inputs.clone(),
             slopes: self.dae.slopes.clone(),
@@ -519,6 +543,7 @@ impl Simulator {
         let fits = s.y.len() == self.radau.y.len()
             && s.r0.len() == d.sys.r0.len()
             && s.angle_refs.len() == d.sys.angle_refs.len()
+            && s.angle_rates.len() == d.sys.angle_rates.len()
             && s.spring_refs.len() == d.sys.forces.len()
             && s.inputs.len() == d.inputs.len()
             && s.slopes.len() == d.slopes.len();
@@ -530,6 +555,8 @@ impl Simulator {
         self.radau.y.clone_from(&s.y);
         self.dae.sys.r0.clone_from(&s.r0);
         self.dae.sys.angle_refs.clone_from(&s.angle_refs);
+        self.dae.sys.angle_rates.clone_from(&s.angle_rates);
+        self.dae.sys.angle_time = s.angle_time;
         for (f, &a) in self.dae.sys.forces.iter_mut().zip(&s.spring_refs) {
             f.angle_ref = a;
         }

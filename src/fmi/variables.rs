@@ -75,6 +75,9 @@ pub struct StateLayout {
     /// expression).
     pub s_units: Vec<Option<String>>,
     pub w_units: Vec<Option<String>>,
+    /// What each S and W measures, frame stated (FMI variable descriptions).
+    pub s_about: Vec<String>,
+    pub w_about: Vec<String>,
 }
 
 impl StateLayout {
@@ -147,7 +150,7 @@ pub fn variables(model: &Model) -> Vec<Variable> {
     for (k, name) in lay.s.iter().enumerate() {
         let mut x = var(name.clone(), v.len(), Target::State(k));
         x.unit = lay.s_units[k].clone();
-        x.description = Some("linearization state (seed Eq. 33)".into());
+        x.description = Some(lay.s_about[k].clone());
         x.known = Some(k);
         v.push(x);
     }
@@ -170,7 +173,7 @@ pub fn variables(model: &Model) -> Vec<Variable> {
     for j in (0..s1).filter(|&j| lay.w_of[j].is_none()) {
         let mut x = var(lay.w[j].clone(), v.len(), Target::Velocity(j));
         x.unit = lay.w_units[j].clone();
-        x.description = Some("velocity state (non-holonomic model)".into());
+        x.description = Some(lay.w_about[j].clone());
         x.known = Some(s0 + j);
         w_index[j] = v.len() + 1;
         v.push(x);
@@ -216,5 +219,7 @@ pub fn state_layout(model: &Model) -> StateLayout {
     let w_of = w.iter().map(|n| s.iter().position(|sn| format!("der({sn})") == *n)).collect();
     let s_units = sel.states.iter().map(|x| x.unit()).collect();
     let w_units = sel.velocities.iter().map(|x| x.unit()).collect();
-    StateLayout { s, w, w_of, s_units, w_units }
+    let s_about = sel.states.iter().map(|x| x.description()).collect();
+    let w_about = sel.velocities.iter().map(|x| x.description()).collect();
+    StateLayout { s, w, w_of, s_units, w_units, s_about, w_about }
 }

@@ -3,21 +3,24 @@
 //! right-hand sides, and the eigenvalue table (Tables 2–4).
 
 pub mod augmented;
+pub mod candidates;
 pub mod eigen;
 pub mod jets;
 pub mod outputs;
 pub mod select;
 pub mod select_velocity;
 pub mod states;
+pub mod tiers;
 
 pub use augmented::{Linearization, linearize};
-pub use select::{Selection, select_states};
+pub use candidates::Candidates;
+pub use select::{Selection, select_states, select_states_among};
 
 use crate::dae::{EngineError, SimOptions, Simulator};
 use crate::mechanics::System;
 use crate::model::Model;
 use jets::jets;
-use states::{VelState, internal_state, user_states};
+use states::{VelState, internal_state, joint_states, user_states};
 
 /// The states an FMU of `model` exposes: selected (Eq. 33) from the assembled initial
 /// configuration with the model's own parameter values and experiment start.
@@ -28,11 +31,13 @@ pub fn selection_at_start(model: &Model) -> Result<Selection, EngineError> {
     select_states(sim.system(), sim.q(), t0, &sim.inputs()).map_err(EngineError::Numeric)
 }
 
-/// Rebuild a selection from state names: position states (user state names, or
-/// `body.x|y|z|psi|theta|phi`, the angles relative to each body's current reference frame)
+/// Rebuild a selection from state names: position states (user state names, joint
+/// coordinates `joint.angle` ..., or `body.x|y|z|psi|theta|phi`, the angles relative to
+/// each body's current reference frame)
 /// and velocity states (`der(<position state>)`, a user `<velocity>`, or `der(body.x)` ...).
 pub fn selection_by_name(sys: &System, names: &[String], w_names: &[String]) -> Result<Selection, String> {
-    let users = user_states(sys);
+    let mut users = user_states(sys);
+    users.extend(joint_states(sys));
     let coord = ["x", "y", "z", "psi", "theta", "phi"];
     let states = names
         .iter()

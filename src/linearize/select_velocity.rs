@@ -1,36 +1,50 @@
 //! Velocity-level state selection (the seed's closing remark on non-holonomic systems):
 //! with non-holonomic constraints there are s1 = s0 − (non-holonomic equations) velocity
 //! states W, chosen separately from the position states S by the same weighted full-pivot
-//! factorization (Eq. 33), written in q̇: J1 = [C_q 0; B T 0; −w_q̇ D] with u = T(q) q̇.
-//! Candidates: user `<velocity>` expressions (weighted most), the time derivatives of the
-//! user position states, then every q̇_i (`der(body.x)` ...).
+//! factorization (Eq. 33, tier by tier as in [`super::tiers`]), written in q̇:
+//! J1 = [C_q 0; B T 0; −w_q̇ D] with u = T(q) q̇. Tiers: user `<velocity>` expressions, then
+//! the time derivatives of the position candidates in their own tiers (user states, joint
+//! coordinates); every q̇_i (`der(body.x)` ...) completes the set.
 
+use super::candidates::{Candidate, TIERS};
 use super::jets::jets;
-use super::select::{D_SMALL, RANK_TOL, USER_ROW_WEIGHT};
-use super::states::{StateFn, VelState, internal_state, user_states, user_velocities};
+use super::select::RANK_TOL;
+use super::states::{StateFn, VelState, internal_state, user_velocities};
+use super::tiers::{CandidateRow, choose_in_tiers};
 use crate::dae::equations::nonholonomic_b;
-use crate::dae::rank::full_pivot;
 use crate::mechanics::System;
 use crate::mechanics::body::{NQ, row_times_t};
 use crate::mechanics::kernels::constraint_first;
 
-/// Preference of explicit `<velocity>` candidates over derivatives of user position states:
-/// their rows weigh this much more and their D entries this much less, so full pivoting
-/// eliminates them first and, between two dependent candidates, pivots (drops) the other.
-const VELOCITY_PREFERENCE: f64 = 10.0;
+/// Sparse entries of a dense row.
+fn sparse(row: &[f64]) -> Vec<(usize, f64)> {
+    row.iter().enumerate().filter(|(_, v)| **v != 0.0).map(|(c, &v)| (c, v)).collect()
+}
 
-/// Choose the velocity states W at (q, u, t) given the position selection `states`.
+/// Choose the velocity states W at (q, u, t) among the user's `<velocity>` expressions
+/// and the derivatives of the position candidates `pos`; also returns the names of
+/// dropped user candidates.
 pub fn select_velocities(
     sys: &System,
     q: &[f64],
     u: &[f64],
     t: f64,
     ext: &[f64],
+    pos: &[Candidate],
 ) -> Result<(Vec<VelState>, Vec<String>), String> {
     let n = sys.n();
     let zeros = vec![0.0; n];
-    // (candidate, its q̇-row, row weight, its D entry)
-    let mut cands: Vec<(VelState, Vec<f64>, f64, f64)> = Vec::new();
+    // (candidate, a user's) by tier, with their q̇-rows.
+    let mut cands: Vec<Vec<(VelState, bool)>> = vec![Vec::new(); TIERS + 1];
+    let mut tiers: Vec<Vec<CandidateRow>> = vec![Vec::new(); TIERS + 1];
+    let mut push = |tier: usize, c: VelState, user: bool, row: Vec<f64>| {
+        if row.iter().any(|v| !v.is_finite()) {
+            return Err(format!("velocity candidate '{}' has no finite derivative here", c.name()));
+        }
+        tiers[tier].push(CandidateRow { entries: sparse(&row) });
+        cands[tier].push((c, user));
+        Ok(())
+    };
     for v in user_velocities(sys) {
         let j = &jets(sys, &v, q, u, &zeros, t, ext)[0];
         let nql = NQ * v.bodies.len();
@@ -39,32 +53,26 @@ pub fn select_velocities(
             row[NQ * v.bodies[a / NQ] + a % NQ] = j.dg[nql + a];
         }
         row_times_t(q, &mut row);
-        cands.push((VelState::User(v), row, USER_ROW_WEIGHT * VELOCITY_PREFERENCE, D_SMALL / VELOCITY_PREFERENCE));
+        push(0, VelState::User(v), true, row)?;
     }
-    for s in user_states(sys) {
-        let j = &jets(sys, &s, q, u, &zeros, t, ext)[0];
+    for Candidate { state: s, tier, user } in pos {
+        let j = &jets(sys, s, q, u, &zeros, t, ext)[0];
         let mut row = vec![0.0; n];
         for (a, &b) in s.bodies.iter().enumerate() {
             for c in 0..NQ {
                 row[NQ * b + c] = j.dg[NQ * a + c];
             }
         }
-        cands.push((VelState::Derivative(s), row, USER_ROW_WEIGHT, D_SMALL));
+        push(tier + 1, VelState::Derivative(s.clone()), *user, row)?;
     }
-    let nc = cands.len();
-    let mut rows: Vec<Vec<f64>> = Vec::new();
+    let mut fixed: Vec<(usize, usize, f64)> = Vec::new();
+    let mut nf = 0;
     for el in &sys.constraints {
         let f = constraint_first(sys, el, q, t, ext);
         let nql = NQ * el.bodies.len();
-        for e in 0..el.neq {
-            if sys.redundant[el.row + e] {
-                continue;
-            }
-            let mut row = vec![0.0; n];
-            for a in 0..nql {
-                row[NQ * el.bodies[a / NQ] + a % NQ] += f.cq[e * nql + a];
-            }
-            rows.push(row);
+        for e in (0..el.neq).filter(|e| !sys.redundant[el.row + e]) {
+            fixed.extend((0..nql).map(|a| (nf, NQ * el.bodies[a / NQ] + a % NQ, f.cq[e * nql + a])));
+            nf += 1;
         }
     }
     let (b, _) = nonholonomic_b(sys, q, u, t, ext);
@@ -74,39 +82,27 @@ pub fn select_velocities(
     }
     for mut row in brows {
         row_times_t(q, &mut row);
-        rows.push(row);
+        fixed.extend(sparse(&row).into_iter().map(|(c, v)| (nf, c, v)));
+        nf += 1;
     }
-    let nr = rows.len();
-    let mut j: Vec<(usize, usize, f64)> = Vec::new();
-    for (r, row) in rows.iter().enumerate() {
-        j.extend(row.iter().enumerate().filter(|(_, v)| **v != 0.0).map(|(c, &v)| (r, c, v)));
-    }
-    for (k, (c, row, w, dk)) in cands.iter().enumerate() {
-        if row.iter().any(|v| !v.is_finite()) {
-            return Err(format!("velocity candidate '{}' has no finite derivative here", c.name()));
-        }
-        j.extend(row.iter().enumerate().filter(|(_, v)| **v != 0.0).map(|(col, &v)| (nr + k, col, -w * v)));
-        j.push((nr + k, n + k, w * dk));
-    }
-    // Sparse complete pivoting (as at position level). Every candidate row has its own D
-    // column, so J1 has full row rank exactly when the (independent) holonomic rows and the
-    // non-holonomic rows are independent together.
-    let piv = full_pivot(nr + nc, n + nc, j, RANK_TOL * RANK_TOL, 1.0)
-        .map_err(|e| format!("the velocity constraint Jacobian is not finite here ({e})"))?;
-    if piv.rank < nr + nc {
-        return Err("the non-holonomic constraints are not independent of the others".into());
-    }
-    let pivoted = piv.pivoted_cols(n + nc);
+    // Sparse complete pivoting (as at position level); the (independent) holonomic rows
+    // and the non-holonomic rows must be independent together.
+    let choice = choose_in_tiers(n, nf, &fixed, &tiers, RANK_TOL * RANK_TOL, true).map_err(|e| match e {
+        Some(e) => format!("the velocity constraint Jacobian is not finite here ({e})"),
+        None => "the non-holonomic constraints are not independent of the others".into(),
+    })?;
     let mut out: Vec<VelState> = Vec::new();
     let mut dropped = Vec::new();
-    for (k, (c, _, _, _)) in cands.into_iter().enumerate() {
-        if !pivoted[n + k] {
-            out.push(c);
-        } else {
-            dropped.push(c.name());
+    for (tier, cs) in cands.into_iter().enumerate() {
+        for (k, (c, user)) in cs.into_iter().enumerate() {
+            if choice.chosen[tier].get(k).copied().unwrap_or(false) {
+                out.push(c);
+            } else if user {
+                dropped.push(c.name());
+            }
         }
     }
-    out.extend((0..n).filter(|&c| !pivoted[c]).map(|c| VelState::Derivative(internal_state(sys, c))));
+    out.extend(choice.free.iter().map(|&c| VelState::Derivative(internal_state(sys, c))));
     Ok((out, dropped))
 }
 

@@ -1,6 +1,7 @@
 //! Linearization states S = s(q, t) (seed Eq. 30, 34f): user expressions, and the internal
-//! candidates — each body's CM coordinates and its 3-1-3 angles relative to a reference
-//! frame fixed at selection time (so the names mean the same at every later point).
+//! candidates — the joints' free coordinates, then each body's CM coordinates and its
+//! 3-1-3 angles relative to a reference frame fixed at selection time (so the names mean
+//! the same at every later point).
 
 use super::jets::{PositionFn, jets};
 use crate::ad::Real;
@@ -98,6 +99,8 @@ pub fn user_velocities(sys: &System) -> Vec<UserVelocity> {
 pub enum StateKind {
     /// A `<linearization><state>` expression with its angle-unwrapping slot base.
     User { f: Expr, abase: usize },
+    /// A joint's free coordinate (`sys.joint_coords`): what it measures, frame stated.
+    Joint { f: Expr, abase: usize, about: String },
     /// CM coordinate k (x, y, z) of a body, ground frame.
     Position { k: usize },
     /// 3-1-3 angle k (ψ, θ, φ) of a body relative to the fixed frame `r0`.
@@ -121,7 +124,7 @@ impl PositionFn for StateFn {
     }
     fn eval<T: Real>(&self, ctx: &LocalCtx<T>, out: &mut [T]) {
         out[0] = match &self.kind {
-            StateKind::User { f, abase } => ctx.eval_expr(f, *abase),
+            StateKind::User { f, abase } | StateKind::Joint { f, abase, .. } => ctx.eval_expr(f, *abase),
             StateKind::Position { k } => ctx.bodies[0].r.0[*k],
             StateKind::Angle { k, r0 } => euler313_from_matrix(&M3::cst(r0).t().mm(&ctx.bodies[0].a))[*k],
         };
@@ -137,6 +140,20 @@ pub fn user_states(sys: &System) -> Vec<StateFn> {
             bodies.sort_unstable();
             bodies.dedup();
             StateFn { name: name.clone(), kind: StateKind::User { f: f.clone(), abase: *abase }, bodies }
+        })
+        .collect()
+}
+
+/// The joints' free coordinates as state candidates (joint order).
+pub fn joint_states(sys: &System) -> Vec<StateFn> {
+    sys.joint_coords
+        .iter()
+        .map(|c| {
+            let mut bodies: Vec<usize> = deps(&c.f).markers.iter().filter_map(|&m| sys.markers[m].body).collect();
+            bodies.sort_unstable();
+            bodies.dedup();
+            let kind = StateKind::Joint { f: c.f.clone(), abase: c.abase, about: c.about.clone() };
+            StateFn { name: c.name.clone(), kind, bodies }
         })
         .collect()
 }
@@ -157,12 +174,41 @@ impl StateFn {
         match &self.kind {
             StateKind::Position { .. } => Some("m".into()),
             StateKind::Angle { .. } => Some("rad".into()),
-            StateKind::User { f, .. } => crate::model::units::of_expr(f).map(str::to_string),
+            StateKind::User { f, .. } | StateKind::Joint { f, .. } => {
+                crate::model::units::of_expr(f).map(str::to_string)
+            }
+        }
+    }
+
+    /// What the state measures, frame stated (an FMI variable description).
+    pub fn description(&self) -> String {
+        match &self.kind {
+            StateKind::User { .. } => "user linearization state".into(),
+            StateKind::Joint { about, .. } => about.clone(),
+            StateKind::Position { .. } => {
+                let (b, c) = self.name.rsplit_once('.').unwrap_or((&self.name, ""));
+                format!("{c} of body '{b}' CM, ground frame")
+            }
+            StateKind::Angle { .. } => {
+                let (b, c) = self.name.rsplit_once('.').unwrap_or((&self.name, ""));
+                format!(
+                    "3-1-3 angle {c} of body '{b}' in its fixed reference frame R0 (in which the \
+                     orientation the model file gives reads (0, pi/2, 0))"
+                )
+            }
         }
     }
 }
 
 impl VelState {
+    /// What it measures (an FMI variable description).
+    pub fn description(&self) -> String {
+        match self {
+            VelState::Derivative(s) => format!("time derivative of: {}", s.description()),
+            VelState::User(_) => "user velocity state (non-holonomic model)".into(),
+        }
+    }
+
     /// The velocity state's unit (that of Ṡ, or of the user's velocity expression).
     pub fn unit(&self) -> Option<String> {
         match self {

@@ -26,6 +26,9 @@ pub struct LocalBody<T: Real> {
     pub wdot: V3<T>,
 }
 
+/// Recorded angle measures: (global slot, value, rate).
+pub type AngleRecord = RefCell<Vec<(usize, f64, f64)>>;
+
 /// Element-local evaluation context.
 pub struct LocalCtx<'a, T: Real> {
     pub sys: &'a System,
@@ -41,8 +44,9 @@ pub struct LocalCtx<'a, T: Real> {
     pub loads: Option<&'a dyn Fn(LoadFn, ElementRef) -> T>,
     /// First global angle slot of the expression being evaluated.
     angle_base: Cell<usize>,
-    /// When set, every unwrapped angle is recorded as (global slot, value).
-    pub record: Option<&'a RefCell<Vec<(usize, f64)>>>,
+    /// When set, every unwrapped angle is recorded as (global slot, value, rate): the rate
+    /// is the first derivative the scalars carry (a time direction, when so seeded).
+    pub record: Option<&'a AngleRecord>,
     /// Whether accelerations were given (else they are zero, or external values).
     has_udot: bool,
     /// When set, inputs and user unknowns read these (e.g. seeded dual numbers, same
@@ -176,11 +180,15 @@ impl<T: Real> ExprEnv<T> for LocalCtx<'_, T> {
     /// Angles stay on the branch nearest their value at the last accepted step.
     fn unwrap_angle(&self, slot: usize, a: T) -> T {
         let g = self.angle_base.get() + slot;
+        // The branch nearest the reference extrapolated with its rate to this time, so a
+        // fast rotation stays continuous over steps longer than half a turn.
         let r = self.sys.angle_refs.get(g).copied().unwrap_or(f64::NAN);
+        let rate = self.sys.angle_rates.get(g).copied().filter(|v| v.is_finite()).unwrap_or(0.0);
+        let r = r + rate * (self.t.val() - self.sys.angle_time);
         let two_pi = 2.0 * std::f64::consts::PI;
         let out = if r.is_finite() { a + T::cst(two_pi * ((r - a.val()) / two_pi).round()) } else { a };
         if let Some(rec) = self.record {
-            rec.borrow_mut().push((g, out.val()));
+            rec.borrow_mut().push((g, out.val(), out.tangent()));
         }
         out
     }

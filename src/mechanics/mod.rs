@@ -7,6 +7,7 @@ pub mod body;
 pub mod components;
 pub mod constraints;
 pub mod forces;
+pub mod joint_coords;
 pub mod kernels;
 pub mod loads;
 pub mod local;

@@ -8,6 +8,7 @@
 use super::body::NQ;
 use super::constraints::{ConstraintEl, ConstraintKind, VelocityIc};
 use super::forces::{ForceEl, ForceKind};
+use super::joint_coords::{JointCoord, joint_coordinates};
 use super::kernels::MAX_ELEMENT_BODIES;
 use super::nonholonomic::{NonholonomicEl, NonholonomicKind};
 use super::user::{UserEq, UserKind, ext_refs};
@@ -88,9 +89,15 @@ pub struct System {
     pub lin_states: Vec<(String, Expr, usize)>,
     /// User velocity candidates `<linearization><velocity>`: name, w(q, u, t), slot base.
     pub lin_velocities: Vec<(String, Expr, usize)>,
+    /// The joints' free coordinates (internal state candidates, joint order).
+    pub joint_coords: Vec<JointCoord>,
     /// Value of every angle measure at the last accepted step (NaN: none yet); expressions
     /// keep their angles on the branch nearest these, so angles are continuous in time.
     pub angle_refs: Vec<f64>,
+    /// Their time derivatives then (NaN: unknown), and that time: an angle is unwrapped
+    /// to the branch nearest `angle_refs + angle_rates · (t − angle_time)`.
+    pub angle_rates: Vec<f64>,
+    pub angle_time: f64,
     /// Initial (unassembled) coordinates and velocities from the model file.
     pub q_init: Vec<f64>,
     pub u_init: Vec<f64>,
@@ -438,6 +445,8 @@ impl System {
                 ));
             }
         }
+        let joint_coords =
+            model.joints.iter().flat_map(|jt| joint_coordinates(jt, &model.markers, &mut alloc)).collect();
         Ok(System {
             params,
             gravity: model.gravity,
@@ -474,7 +483,10 @@ impl System {
                 .iter()
                 .map(|s| (s.name.clone(), s.function.clone(), alloc(&s.function)))
                 .collect(),
+            joint_coords,
             angle_refs: vec![f64::NAN; slots],
+            angle_rates: vec![f64::NAN; slots],
+            angle_time: 0.0,
             output_names: model.outputs.iter().map(|o| o.name.clone()).collect(),
             input_names: model.inputs.iter().map(|i| i.name.clone()).collect(),
             outputs: model.outputs.iter().map(|o| o.function.clone()).collect(),
