@@ -10,10 +10,8 @@ use super::candidates::{Candidate, Candidates, TIERS, position_candidates};
 use super::jets::{PositionFn, jets};
 use super::select_velocity::{derivative_states, select_velocities};
 use super::states::{StateFn, VelState, internal_state};
-use super::tiers::{CandidateRow, choose_in_tiers};
+use super::tiers::{CandidateRow, TierError, choose_in_tiers, constraint_rows, gradient_row};
 use crate::mechanics::System;
-use crate::mechanics::body::NQ;
-use crate::mechanics::kernels::constraint_first;
 
 /// A pivot below this fraction of the largest pivot (at least 1) counts as zero (rank decision).
 pub const RANK_TOL: f64 = 1e-9;
@@ -61,28 +59,16 @@ pub fn select_states_among(
             }
             continue;
         }
-        let mut row = CandidateRow::default();
-        for (a, &b) in c.state.bodies().iter().enumerate() {
-            row.entries.extend((0..NQ).map(|col| (NQ * b + col, g.dg[NQ * a + col])));
-        }
-        tiers[c.tier].push(row);
+        tiers[c.tier].push(gradient_row(c.state.bodies(), &g.dg));
         of_tier[c.tier].push(cands.len());
         cands.push(c);
     }
-    let mut fixed: Vec<(usize, usize, f64)> = Vec::new();
-    let mut nf = 0;
-    for el in &sys.constraints {
-        let f = constraint_first(sys, el, q, t, inputs);
-        let nql = NQ * el.bodies.len();
-        for e in (0..el.neq).filter(|e| !sys.redundant[el.row + e]) {
-            // (redundant rows are left out: they add no rank)
-            fixed.extend((0..nql).map(|a| (nf, NQ * el.bodies[a / NQ] + a % NQ, f.cq[e * nql + a])));
-            nf += 1;
-        }
-    }
+    let (fixed, nf) = constraint_rows(sys, q, t, inputs);
     // Sparse Gaussian elimination with complete pivoting (Eq. 33); pivots > RANK_TOL·max(largest, 1).
-    let choice = choose_in_tiers(n, nf, &fixed, &tiers, RANK_TOL, false)
-        .map_err(|e| format!("the constraint Jacobian is not finite here ({})", e.unwrap_or_default()))?;
+    let choice = choose_in_tiers(n, nf, &fixed, &tiers, RANK_TOL, false).map_err(|e| match e {
+        TierError::NotFinite(e) => format!("the constraint Jacobian is not finite here ({e})"),
+        TierError::Dependent => "the constraints are not independent".into(), // (not asked for)
+    })?;
     let mut picked = vec![false; cands.len()];
     for (t, ks) in of_tier.iter().enumerate() {
         for (k, &c) in ks.iter().enumerate() {

@@ -10,11 +10,10 @@ use super::candidates::{Candidate, TIERS};
 use super::jets::jets;
 use super::select::RANK_TOL;
 use super::states::{StateFn, VelState, internal_state, user_velocities};
-use super::tiers::{CandidateRow, choose_in_tiers};
+use super::tiers::{CandidateRow, TierError, choose_in_tiers, constraint_rows, gradient_row};
 use crate::dae::equations::nonholonomic_b;
 use crate::mechanics::System;
 use crate::mechanics::body::{NQ, row_times_t};
-use crate::mechanics::kernels::constraint_first;
 
 /// Sparse entries of a dense row.
 fn sparse(row: &[f64]) -> Vec<(usize, f64)> {
@@ -37,11 +36,11 @@ pub fn select_velocities(
     // (candidate, a user's) by tier, with their q̇-rows.
     let mut cands: Vec<Vec<(VelState, bool)>> = vec![Vec::new(); TIERS + 1];
     let mut tiers: Vec<Vec<CandidateRow>> = vec![Vec::new(); TIERS + 1];
-    let mut push = |tier: usize, c: VelState, user: bool, row: Vec<f64>| {
-        if row.iter().any(|v| !v.is_finite()) {
+    let mut push = |tier: usize, c: VelState, user: bool, row: CandidateRow| {
+        if row.entries.iter().any(|(_, v)| !v.is_finite()) {
             return Err(format!("velocity candidate '{}' has no finite derivative here", c.name()));
         }
-        tiers[tier].push(CandidateRow { entries: sparse(&row) });
+        tiers[tier].push(row);
         cands[tier].push((c, user));
         Ok(())
     };
@@ -53,28 +52,14 @@ pub fn select_velocities(
             row[NQ * v.bodies[a / NQ] + a % NQ] = j.dg[nql + a];
         }
         row_times_t(q, &mut row);
-        push(0, VelState::User(v), true, row)?;
+        push(0, VelState::User(v), true, CandidateRow { entries: sparse(&row) })?;
     }
     for Candidate { state: s, tier, user } in pos {
+        // d/dt s(q) = s_q q̇: the position gradient is the q̇-row.
         let j = &jets(sys, s, q, u, &zeros, t, ext)[0];
-        let mut row = vec![0.0; n];
-        for (a, &b) in s.bodies.iter().enumerate() {
-            for c in 0..NQ {
-                row[NQ * b + c] = j.dg[NQ * a + c];
-            }
-        }
-        push(tier + 1, VelState::Derivative(s.clone()), *user, row)?;
+        push(tier + 1, VelState::Derivative(s.clone()), *user, gradient_row(&s.bodies, &j.dg))?;
     }
-    let mut fixed: Vec<(usize, usize, f64)> = Vec::new();
-    let mut nf = 0;
-    for el in &sys.constraints {
-        let f = constraint_first(sys, el, q, t, ext);
-        let nql = NQ * el.bodies.len();
-        for e in (0..el.neq).filter(|e| !sys.redundant[el.row + e]) {
-            fixed.extend((0..nql).map(|a| (nf, NQ * el.bodies[a / NQ] + a % NQ, f.cq[e * nql + a])));
-            nf += 1;
-        }
-    }
+    let (mut fixed, mut nf) = constraint_rows(sys, q, t, ext);
     let (b, _) = nonholonomic_b(sys, q, u, t, ext);
     let mut brows = vec![vec![0.0; n]; sys.mn];
     for (r, c, v) in b {
@@ -88,8 +73,8 @@ pub fn select_velocities(
     // Sparse complete pivoting (as at position level); the (independent) holonomic rows
     // and the non-holonomic rows must be independent together.
     let choice = choose_in_tiers(n, nf, &fixed, &tiers, RANK_TOL * RANK_TOL, true).map_err(|e| match e {
-        Some(e) => format!("the velocity constraint Jacobian is not finite here ({e})"),
-        None => "the non-holonomic constraints are not independent of the others".into(),
+        TierError::NotFinite(e) => format!("the velocity constraint Jacobian is not finite here ({e})"),
+        TierError::Dependent => "the non-holonomic constraints are not independent of the others".into(),
     })?;
     let mut out: Vec<VelState> = Vec::new();
     let mut dropped = Vec::new();

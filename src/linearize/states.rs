@@ -81,15 +81,23 @@ impl VelState {
     }
 }
 
+/// The bodies (sorted, once each) whose markers expression `f` reads.
+fn expr_bodies(sys: &System, f: &Expr) -> Vec<usize> {
+    let mut bodies: Vec<usize> = deps(f).markers.iter().filter_map(|&m| sys.markers[m].body).collect();
+    bodies.sort_unstable();
+    bodies.dedup();
+    bodies
+}
+
 /// The user's `<velocity>` candidates of the model.
 pub fn user_velocities(sys: &System) -> Vec<UserVelocity> {
     sys.lin_velocities
         .iter()
-        .map(|(name, f, abase)| {
-            let mut bodies: Vec<usize> = deps(f).markers.iter().filter_map(|&m| sys.markers[m].body).collect();
-            bodies.sort_unstable();
-            bodies.dedup();
-            UserVelocity { name: name.clone(), f: f.clone(), abase: *abase, bodies }
+        .map(|(name, f, abase)| UserVelocity {
+            name: name.clone(),
+            f: f.clone(),
+            abase: *abase,
+            bodies: expr_bodies(sys, f),
         })
         .collect()
 }
@@ -136,10 +144,8 @@ pub fn user_states(sys: &System) -> Vec<StateFn> {
     sys.lin_states
         .iter()
         .map(|(name, f, abase)| {
-            let mut bodies: Vec<usize> = deps(f).markers.iter().filter_map(|&m| sys.markers[m].body).collect();
-            bodies.sort_unstable();
-            bodies.dedup();
-            StateFn { name: name.clone(), kind: StateKind::User { f: f.clone(), abase: *abase }, bodies }
+            let kind = StateKind::User { f: f.clone(), abase: *abase };
+            StateFn { name: name.clone(), kind, bodies: expr_bodies(sys, f) }
         })
         .collect()
 }
@@ -149,11 +155,8 @@ pub fn joint_states(sys: &System) -> Vec<StateFn> {
     sys.joint_coords
         .iter()
         .map(|c| {
-            let mut bodies: Vec<usize> = deps(&c.f).markers.iter().filter_map(|&m| sys.markers[m].body).collect();
-            bodies.sort_unstable();
-            bodies.dedup();
             let kind = StateKind::Joint { f: c.f.clone(), abase: c.abase, about: c.about.clone() };
-            StateFn { name: c.name.clone(), kind, bodies }
+            StateFn { name: c.name.clone(), kind, bodies: expr_bodies(sys, &c.f) }
         })
         .collect()
 }

@@ -9,6 +9,9 @@
 //! pivot complete the set (body coordinates).
 
 use crate::dae::rank::full_pivot;
+use crate::mechanics::System;
+use crate::mechanics::body::NQ;
+use crate::mechanics::kernels::constraint_first;
 
 /// Weight W of candidate rows relative to constraint rows (Eq. 33's row weighting).
 pub const ROW_WEIGHT: f64 = 1e3;
@@ -19,6 +22,39 @@ pub const D_SMALL: f64 = 1e-3;
 #[derive(Clone, Debug, Default)]
 pub struct CandidateRow {
     pub entries: Vec<(usize, f64)>,
+}
+
+/// The gradient `dg` of a function of `bodies` (NQ entries per body, local order) as a
+/// candidate row over the global coordinates.
+pub fn gradient_row(bodies: &[usize], dg: &[f64]) -> CandidateRow {
+    let entries = bodies.iter().enumerate().flat_map(|(a, &b)| (0..NQ).map(move |c| (NQ * b + c, dg[NQ * a + c])));
+    CandidateRow { entries: entries.collect() }
+}
+
+/// The independent (non-redundant) rows of C_q at (q, t) as (row, col, value), and their
+/// number: the constraint rows F of every tier.
+pub fn constraint_rows(sys: &System, q: &[f64], t: f64, ext: &[f64]) -> (Vec<(usize, usize, f64)>, usize) {
+    let mut fixed = Vec::new();
+    let mut nf = 0;
+    for el in &sys.constraints {
+        let f = constraint_first(sys, el, q, t, ext);
+        let nql = NQ * el.bodies.len();
+        for e in (0..el.neq).filter(|e| !sys.redundant[el.row + e]) {
+            // (redundant rows are left out: they add no rank)
+            fixed.extend((0..nql).map(|a| (nf, NQ * el.bodies[a / NQ] + a % NQ, f.cq[e * nql + a])));
+            nf += 1;
+        }
+    }
+    (fixed, nf)
+}
+
+/// Why [`choose_in_tiers`] gave no choice.
+#[derive(Clone, Debug)]
+pub enum TierError {
+    /// An entry is not finite (the message of [`full_pivot`]).
+    NotFinite(String),
+    /// The constraint rows are not independent (asked for with `full_rank`).
+    Dependent,
 }
 
 /// The outcome: per tier, which candidates were chosen; the coordinates left free.
@@ -33,8 +69,7 @@ pub struct TierChoice {
 
 /// Choose among `tiers` of candidates given `nf` constraint rows `fixed` (row, col, value)
 /// over `n` coordinates. Pivots below `tol`·max(largest, 1) count as zero. With
-/// `full_rank`, constraint rows that are not independent are an error (returned as `Err`
-/// with no message; the caller words it).
+/// `full_rank`, constraint rows that are not independent are an error.
 pub fn choose_in_tiers(
     n: usize,
     nf: usize,
@@ -42,7 +77,7 @@ pub fn choose_in_tiers(
     tiers: &[Vec<CandidateRow>],
     tol: f64,
     full_rank: bool,
-) -> Result<TierChoice, Option<String>> {
+) -> Result<TierChoice, TierError> {
     let mut rows: Vec<(usize, usize, f64)> = fixed.to_vec();
     let mut nrows = nf;
     let mut chosen = Vec::with_capacity(tiers.len());
@@ -59,10 +94,10 @@ pub fn choose_in_tiers(
             j.extend(c.entries.iter().map(|&(col, v)| (nrows + k, col, -ROW_WEIGHT * v)));
             j.push((nrows + k, n + k, ROW_WEIGHT * D_SMALL));
         }
-        let piv = full_pivot(nrows + nc, n + nc, j, tol, 1.0).map_err(Some)?;
+        let piv = full_pivot(nrows + nc, n + nc, j, tol, 1.0).map_err(TierError::NotFinite)?;
         // Every candidate row has its own D column: J has full row rank exactly when F has.
         if full_rank && piv.rank < nrows + nc {
-            return Err(None);
+            return Err(TierError::Dependent);
         }
         rank.get_or_insert(piv.rank - nc);
         let pivoted = piv.pivoted_cols(n + nc);
@@ -77,9 +112,9 @@ pub fn choose_in_tiers(
     let pivoted = match last {
         Some(p) => p,
         None => {
-            let piv = full_pivot(nrows, n, rows, tol, 1.0).map_err(Some)?;
+            let piv = full_pivot(nrows, n, rows, tol, 1.0).map_err(TierError::NotFinite)?;
             if full_rank && piv.rank < nrows {
-                return Err(None);
+                return Err(TierError::Dependent);
             }
             rank = Some(piv.rank);
             piv.pivoted_cols(n)
