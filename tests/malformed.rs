@@ -358,3 +358,30 @@ case!(
     "60_bad_unit_exponent.xml",
     "60_bad_unit_exponent.xml:2:19: input 'F': attribute 'unit': 'm^2' is not a unit: 'm^' is not a unit symbol (write factors joined by '.', e.g. 'N.s/m', 'kg.m2', 'm/s2')"
 );
+
+// Found by the model_loader fuzz target (fuzz/): models the reader accepted and the
+// engine then refused without a location (System::from_model).
+
+case!(
+    m61_variable_touches_five_bodies,
+    "61_variable_touches_five_bodies.xml",
+    "61_variable_touches_five_bodies.xml:7:22: variable 'v': touches 5 bodies (b1, b2, b3, b4, b5); an element may touch at most 4 (measure some of them in <variable> elements and use those)"
+);
+
+case!(
+    m62_gforce_touches_five_bodies,
+    "62_gforce_touches_five_bodies.xml",
+    "62_gforce_touches_five_bodies.xml:10:76: gforce 'g': touches 5 bodies (b1, b2, b3, b4, b5); an element may touch at most 4 (measure some of them in <variable> elements and use those)"
+);
+
+case!(
+    m63_reads_load_of_load_reader,
+    "63_reads_load_of_load_reader.xml",
+    "63_reads_load_of_load_reader.xml:4:22: variable 'v': 'function' reads the load of sforce 's' (line 5), which reads loads itself; forces and user elements may read only loads that read no loads"
+);
+
+case!(
+    m64_sforce_reads_own_load,
+    "64_sforce_reads_own_load.xml",
+    "64_sforce_reads_own_load.xml:4:55: sforce 's': 'function' reads the load of sforce 's' (line 4), which reads loads itself; forces and user elements may read only loads that read no loads"
+);

@@ -11,8 +11,8 @@ use super::system::System;
 use super::user::UserEq;
 use crate::ad::{Dual, Real};
 
-/// Most bodies one element may touch.
-pub const MAX_ELEMENT_BODIES: usize = 4;
+/// Most bodies one element may touch (the model reader enforces it, with a location).
+pub const MAX_ELEMENT_BODIES: usize = crate::model::MAX_ELEMENT_BODIES;
 
 /// Gather the local coordinates of `bodies` from a global vector (6 per body).
 pub fn gather(bodies: &[usize], x: &[f64]) -> Vec<f64> {

@@ -11,6 +11,11 @@ pub use error::ModelError;
 pub use parse::{Summary, load_file, load_str, rotation, try_rotation};
 pub use types::*;
 
+/// Most bodies one element may touch: those of its markers and of the markers its
+/// expressions measure (ground not counted). The engine differentiates each element over
+/// the coordinates of its bodies only; the reader rejects an element touching more.
+pub const MAX_ELEMENT_BODIES: usize = 4;
+
 /// A complete, validated model (the parsed file). Bodies are numbered from 0; ground is
 /// not a body (`None` where a body index is optional). Markers include each body's `cm`.
 #[derive(Clone, Debug, PartialEq)]

@@ -4,9 +4,9 @@
 use super::attrs::{El, constant};
 use super::load::Loader;
 use super::orient::read_orientation;
-use super::validate::{Allowed, check_deps, check_inertia, check_mass};
+use super::validate::{Allowed, check_body_count, check_deps, check_inertia, check_mass};
 use super::xml::XElem;
-use crate::model::expr::{self, MarkerId, Scope};
+use crate::model::expr::{self, ElementRef, Expr, MarkerId, Scope};
 use crate::model::*;
 
 const SPRING_TYPES: &[(&str, SpringType)] =
@@ -16,6 +16,9 @@ impl<'a> Loader<'a> {
     /// Build all elements (motions last: they refer to joints of any position).
     pub(crate) fn build_all(&mut self) -> Result<(), ModelError> {
         let root = self.root;
+        // Forces and user elements with the loads their expressions read (checked once
+        // every force is known).
+        let mut load_readers: Vec<(&'a XElem, &'static str, Vec<ElementRef>)> = Vec::new();
         for x in &root.children {
             let el = self.el(x);
             match x.tag.as_str() {
@@ -39,6 +42,7 @@ impl<'a> Loader<'a> {
                 "constraint" => {
                     let function = el.expr_req("function")?;
                     check_deps(&el, "function", &function, Allowed::Positions)?;
+                    check_body_count(&el, &self.scope, &[], &[("function", &function)], false)?;
                     let c = UserConstraint { name: x.label().into(), function, pos: x.pos };
                     self.model.constraints.push(c);
                 }
@@ -49,14 +53,17 @@ impl<'a> Loader<'a> {
                 "sforce" => {
                     let function = el.expr_req("function")?;
                     check_deps(&el, "function", &function, Allowed::Force)?;
-                    self.model.sforces.push(Sforce {
+                    let s = Sforce {
                         name: x.label().into(),
                         kind: el.keyword_req("type", SPRING_TYPES)?,
                         i: marker_ref(&el, "i")?,
                         j: marker_ref(&el, "j")?,
                         function,
                         pos: x.pos,
-                    });
+                    };
+                    check_body_count(&el, &self.scope, &[s.i, s.j], &[("function", &s.function)], true)?;
+                    load_readers.push((x, "function", expr::deps(&s.function).loads));
+                    self.model.sforces.push(s);
                 }
                 "gforce" => {
                     let force = el.expr_vec3("force")?;
@@ -66,7 +73,7 @@ impl<'a> Loader<'a> {
                             check_deps(&el, attr, e, Allowed::Force)?;
                         }
                     }
-                    self.model.gforces.push(Gforce {
+                    let g = Gforce {
                         name: x.label().into(),
                         i: marker_ref(&el, "i")?,
                         j: opt_marker_ref(&el, "j")?,
@@ -74,7 +81,15 @@ impl<'a> Loader<'a> {
                         force,
                         torque,
                         pos: x.pos,
-                    });
+                    };
+                    let markers: Vec<MarkerId> = [Some(g.i), g.j, g.frame].into_iter().flatten().collect();
+                    let exprs: Vec<(&str, &Expr)> =
+                        g.force.iter().map(|e| ("force", e)).chain(g.torque.iter().map(|e| ("torque", e))).collect();
+                    check_body_count(&el, &self.scope, &markers, &exprs, true)?;
+                    for (attr, e) in exprs {
+                        load_readers.push((x, attr, expr::deps(e).loads));
+                    }
+                    self.model.gforces.push(g);
                 }
                 "bushing" => {
                     let (i, j) = (marker_ref(&el, "i")?, marker_ref(&el, "j")?);
@@ -117,6 +132,7 @@ impl<'a> Loader<'a> {
                 "velocity_constraint" => {
                     let function = el.expr_req("function")?;
                     check_deps(&el, "function", &function, Allowed::Velocities)?;
+                    check_body_count(&el, &self.scope, &[], &[("function", &function)], false)?;
                     if expr::deps(&function).level == 0 {
                         let at = el.get("function").map_or(x.pos, |a| a.pos);
                         return Err(el.err_at(at, "'function' uses no velocities (write a <constraint> instead)"));
@@ -130,11 +146,15 @@ impl<'a> Loader<'a> {
                 "variable" => {
                     let function = el.expr_req("function")?;
                     check_deps(&el, "function", &function, Allowed::Force)?;
+                    check_body_count(&el, &self.scope, &[], &[("function", &function)], true)?;
+                    load_readers.push((x, "function", expr::deps(&function).loads));
                     self.model.variables.push(Variable { name: x.label().into(), function, pos: x.pos });
                 }
                 "differential" => {
                     let function = el.expr_req("function")?;
                     check_deps(&el, "function", &function, Allowed::Force)?;
+                    check_body_count(&el, &self.scope, &[], &[("function", &function)], true)?;
+                    load_readers.push((x, "function", expr::deps(&function).loads));
                     let implicit = el.keyword("implicit", &[("true", true), ("false", false)])?.unwrap_or(false);
                     let me = self.model.differentials.len();
                     if implicit && !expr::deps(&function).diff_dots.contains(&me) {
@@ -179,6 +199,40 @@ impl<'a> Loader<'a> {
         for x in root.children.iter().filter(|x| x.tag == "motion") {
             let m = self.motion(x)?;
             self.model.motions.push(m);
+        }
+        for (x, attr, loads) in load_readers {
+            self.check_load_reads(x, attr, &loads)?;
+        }
+        Ok(())
+    }
+
+    /// A force or user element may read the load of an sforce or gforce only when that
+    /// force's own expressions read no loads (the engine evaluates such loads first,
+    /// from positions, velocities and user states alone).
+    fn check_load_reads(&self, x: &XElem, attr: &str, loads: &[ElementRef]) -> Result<(), ModelError> {
+        for r in loads {
+            let (tag, name, exprs, line): (&str, &str, Vec<&Expr>, usize) = match *r {
+                ElementRef::Sforce(k) => match self.model.sforces.get(k) {
+                    Some(s) => ("sforce", &s.name, vec![&s.function], s.pos.line),
+                    None => continue,
+                },
+                ElementRef::Gforce(k) => match self.model.gforces.get(k) {
+                    Some(g) => ("gforce", &g.name, g.force.iter().chain(&g.torque).collect(), g.pos.line),
+                    None => continue,
+                },
+                _ => continue,
+            };
+            if exprs.iter().any(|e| !expr::deps(e).loads.is_empty()) {
+                let el = self.el(x);
+                let at = el.get(attr).map_or(x.pos, |a| a.pos);
+                return Err(el.err_at(
+                    at,
+                    format!(
+                        "'{attr}' reads the load of {tag} '{name}' (line {line}), which reads loads itself; \
+                         forces and user elements may read only loads that read no loads"
+                    ),
+                ));
+            }
         }
         Ok(())
     }

@@ -1,8 +1,9 @@
 //! Checks on values and on what expressions depend on.
 
 use super::attrs::El;
-use crate::model::ModelError;
-use crate::model::expr::{self, ElementRef, Expr};
+use super::names::ModelScope;
+use crate::model::expr::{self, ElementRef, Expr, MarkerId};
+use crate::model::{MAX_ELEMENT_BODIES, ModelError};
 
 /// A mass must be positive.
 pub(crate) fn check_mass(m: f64) -> Result<(), String> {
@@ -79,4 +80,44 @@ pub(crate) fn check_deps(el: &El, attr: &str, e: &Expr, allowed: Allowed) -> Res
         _ => "positions, time and parameters",
     };
     Err(el.err_at(at, format!("'{attr}' may use only {may} (it uses {used})")))
+}
+
+/// An element touches at most [`MAX_ELEMENT_BODIES`] bodies: those of its `markers` and of
+/// the markers its expressions (`(attribute, expression)`, in order) measure. The error
+/// points at the attribute (or the element) where the count first goes over, and lists
+/// every body; `split_hint` adds how forces and user elements can stay within it.
+pub(crate) fn check_body_count(
+    el: &El,
+    scope: &ModelScope,
+    markers: &[MarkerId],
+    exprs: &[(&str, &Expr)],
+    split_hint: bool,
+) -> Result<(), ModelError> {
+    let mut bodies: Vec<usize> = Vec::new();
+    let mut over_at = None;
+    let mut add = |ms: &[MarkerId], at| {
+        for b in ms.iter().filter_map(|&m| scope.marker_body.get(m).copied().flatten()) {
+            if !bodies.contains(&b) {
+                bodies.push(b);
+                if bodies.len() > MAX_ELEMENT_BODIES && over_at.is_none() {
+                    over_at = Some(at);
+                }
+            }
+        }
+    };
+    add(markers, el.x.pos);
+    for (attr, e) in exprs {
+        add(&expr::deps(e).markers, el.get(attr).map_or(el.x.pos, |a| a.pos));
+    }
+    let Some(at) = over_at else { return Ok(()) };
+    let names: Vec<&str> = bodies.iter().map(|&b| scope.body_names.get(b).map_or("?", String::as_str)).collect();
+    let hint = if split_hint { " (measure some of them in <variable> elements and use those)" } else { "" };
+    Err(el.err_at(
+        at,
+        format!(
+            "touches {} bodies ({}); an element may touch at most {MAX_ELEMENT_BODIES}{hint}",
+            bodies.len(),
+            names.join(", ")
+        ),
+    ))
 }
