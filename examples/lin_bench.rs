@@ -17,8 +17,8 @@ fn main() {
     };
     let model = load_file(std::path::Path::new(&path)).unwrap_or_else(|e| panic!("{e}"));
     let t = Instant::now();
-    let mut sim =
-        Simulator::new(&model, SimOptions { tol: 1e-6, max_step: None }, 0.0).unwrap_or_else(|e| panic!("{e}"));
+    let mut sim = Simulator::new(&model, SimOptions { tol: 1e-6, max_step: None, ..Default::default() }, 0.0)
+        .unwrap_or_else(|e| panic!("{e}"));
     let t_init = t.elapsed().as_secs_f64();
     let t = Instant::now();
     let sel = select_states(sim.system(), sim.q(), 0.0, &sim.inputs()).unwrap();

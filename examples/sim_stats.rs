@@ -1,5 +1,5 @@
 //! Simulate a model file and print integrator statistics and wall time (benchmark aid).
-//! Usage: cargo run --release --example sim_stats -- model.xml END [TOL]
+//! Usage: cargo run --release --example sim_stats -- model.xml END [TOL] [MAX_STEPS]
 
 use mbfmu::dae::{SimOptions, Simulator};
 use mbfmu::model::parse::load_file;
@@ -10,8 +10,10 @@ fn main() {
     let model = load_file(std::path::Path::new(&args[1])).unwrap_or_else(|e| panic!("{e}"));
     let end: f64 = args.get(2).map_or(1.0, |s| s.parse().expect("END"));
     let tol: f64 = args.get(3).map_or(1e-6, |s| s.parse().expect("TOL"));
+    let max_steps: usize = args.get(4).map_or(mbfmu::dae::DEFAULT_MAX_STEPS, |s| s.parse().expect("MAX_STEPS"));
     let t0 = Instant::now();
-    let mut sim = Simulator::new(&model, SimOptions { tol, max_step: None }, 0.0).unwrap_or_else(|e| panic!("{e}"));
+    let mut sim =
+        Simulator::new(&model, SimOptions { tol, max_step: None, max_steps }, 0.0).unwrap_or_else(|e| panic!("{e}"));
     let t_init = t0.elapsed().as_secs_f64();
     sim.advance(end).unwrap_or_else(|e| panic!("{e}"));
     let wall = t0.elapsed().as_secs_f64();

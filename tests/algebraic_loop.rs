@@ -31,7 +31,7 @@ fn pin_friction_loop_dissipates_and_its_torque_follows_the_reaction() {
     // at every output time (to 1e-9: the loop is solved, not lagged); energy decreases
     // monotonically; |C| < tol.
     let m = load_str(MODEL, "pin.xml").unwrap();
-    let mut sim = Simulator::new(&m, SimOptions { tol: 1e-9, max_step: None }, 0.0).unwrap();
+    let mut sim = Simulator::new(&m, SimOptions { tol: 1e-9, max_step: None, ..Default::default() }, 0.0).unwrap();
     let mut e_prev = sim.mechanical_energy();
     for k in 1..=40 {
         sim.advance(0.05 * k as f64).unwrap();
@@ -52,7 +52,7 @@ fn pin_friction_linearization_matches_central_differences_of_the_state_space_map
     // friction torque) at a moving state (t = 0.3) against central differences of the
     // engine's own state-space map with the loop solved (tests/common), 1e-6 relative.
     let m = load_str(MODEL, "pin.xml").unwrap();
-    let mut sim = Simulator::new(&m, SimOptions { tol: 1e-10, max_step: None }, 0.0).unwrap();
+    let mut sim = Simulator::new(&m, SimOptions { tol: 1e-10, max_step: None, ..Default::default() }, 0.0).unwrap();
     let sel = select_states(sim.system(), sim.q(), 0.0, &sim.inputs()).unwrap();
     sim.advance(0.3).unwrap();
     let lin = linearize(&mut sim, &sel, 2).unwrap();

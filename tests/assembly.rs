@@ -23,7 +23,8 @@ fn joint_initial_conditions_are_exact_after_assembly() {
     // onto the pivot and turns it to exactly ic_angle. The assembled angle, angular speed,
     // displacement and speed equal the ICs to round-off (1e-12).
     let m = load_str(PENDULUM_WITH_ICS, "p.xml").unwrap_or_else(|e| panic!("{e}"));
-    let s = Simulator::new(&m, SimOptions { tol: 1e-10, max_step: None }, 0.0).unwrap_or_else(|e| panic!("{e}"));
+    let s = Simulator::new(&m, SimOptions { tol: 1e-10, max_step: None, ..Default::default() }, 0.0)
+        .unwrap_or_else(|e| panic!("{e}"));
     let bob = s.body_state(0);
     // Angle of the bob's x axis about ground y from the ground marker's x axis (= −z).
     let x = [bob.rotation[0][0], bob.rotation[1][0], bob.rotation[2][0]];

@@ -43,7 +43,7 @@ fn benchmark_bicycle_eigenvalues_match_the_published_linearized_equations() {
         let mut p = base.param_values();
         p[base.parameters.iter().position(|x| x.name == "v").unwrap()] = v;
         let m = base.with_params(&p).unwrap();
-        let mut sim = Simulator::new(&m, SimOptions { tol: 1e-10, max_step: None }, 0.0).unwrap();
+        let mut sim = Simulator::new(&m, SimOptions { tol: 1e-10, max_step: None, ..Default::default() }, 0.0).unwrap();
         let sel = select_states(sim.system(), sim.q(), 0.0, &sim.inputs()).unwrap();
         assert_eq!((sel.states.len(), sel.velocities.len()), (7, 3));
         let lin = linearize(&mut sim, &sel, 2).unwrap();

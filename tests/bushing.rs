@@ -22,7 +22,7 @@ fn bushing_at_the_cm_gives_six_oscillators_and_the_static_sag() {
       <analysis static="true"/>
     </multibody>"#;
     let m = load_str(xml, "bush.xml").unwrap();
-    let mut sim = Simulator::new(&m, SimOptions { tol: 1e-10, max_step: None }, 0.0).unwrap();
+    let mut sim = Simulator::new(&m, SimOptions { tol: 1e-10, max_step: None, ..Default::default() }, 0.0).unwrap();
     let y = sim.outputs().unwrap();
     assert!((y[0] - (1.0 - 2.0 * 9.81 / 300.0)).abs() < 1e-9, "sag: z = {}", y[0]);
     assert!((y[1] - 2.0 * 9.81).abs() < 1e-9, "bushing force {}", y[1]);

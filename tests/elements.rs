@@ -6,7 +6,7 @@ use mbfmu::model::parse::load_str;
 
 fn sim(xml: &str, tol: f64) -> Simulator {
     let m = load_str(xml, "t.xml").unwrap_or_else(|e| panic!("{e}"));
-    Simulator::new(&m, SimOptions { tol, max_step: None }, 0.0).unwrap_or_else(|e| panic!("{e}"))
+    Simulator::new(&m, SimOptions { tol, max_step: None, ..Default::default() }, 0.0).unwrap_or_else(|e| panic!("{e}"))
 }
 
 fn out(s: &mut Simulator, name: &str) -> f64 {

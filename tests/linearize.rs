@@ -12,7 +12,7 @@ use mbfmu::model::parse::load_str;
 
 /// Eigenvalue rows (frequency, damping, re, im) at time t.
 fn eig_at(m: &Model, t: f64) -> (Vec<String>, Vec<(f64, f64)>) {
-    let mut sim = Simulator::new(m, SimOptions { tol: 1e-10, max_step: None }, 0.0).unwrap();
+    let mut sim = Simulator::new(m, SimOptions { tol: 1e-10, max_step: None, ..Default::default() }, 0.0).unwrap();
     let sel = select_states(sim.system(), sim.q(), 0.0, &sim.inputs()).unwrap();
     sim.advance(t).unwrap();
     let lin = linearize(&mut sim, &sel, 2).unwrap();
@@ -139,7 +139,7 @@ fn singular_partition_is_reported_not_returned_as_a_matrix() {
   <linearization><state name="yc" function="dy(b.cm)"/></linearization>
 </multibody>"#;
     let m = load_str(xml, "r.xml").unwrap();
-    let mut sim = Simulator::new(&m, SimOptions { tol: 1e-12, max_step: None }, 0.0).unwrap();
+    let mut sim = Simulator::new(&m, SimOptions { tol: 1e-12, max_step: None, ..Default::default() }, 0.0).unwrap();
     let sel = select_states(sim.system(), sim.q(), 0.0, &sim.inputs()).unwrap();
     assert_eq!(sel.states[0].name, "yc");
     assert!(linearize(&mut sim, &sel, 1).is_ok());
@@ -185,7 +185,7 @@ fn spatial_arm_abcd_match_central_differences_of_the_state_space_equations() {
     // truncation ~1e-12·|f'''|, round-off ~1e-16/1e-6 · |f| ≈ 1e-9 relative, so 1e-6
     // (relative to max(1, |entry|)) is a safe bound that still catches any wrong term.
     let m = load_str(ARM, "arm.xml").unwrap();
-    let mut sim = Simulator::new(&m, SimOptions { tol: 1e-10, max_step: None }, 0.0).unwrap();
+    let mut sim = Simulator::new(&m, SimOptions { tol: 1e-10, max_step: None, ..Default::default() }, 0.0).unwrap();
     let sel = select_states(sim.system(), sim.q(), 0.0, &sim.inputs()).unwrap();
     assert_eq!(sel.states.len(), 3);
     sim.advance(0.3).unwrap();
@@ -248,7 +248,7 @@ fn static_analysis_finds_the_equilibrium_and_its_analytic_frequencies() {
     for (k, (re, im)) in rows.iter().enumerate() {
         assert!(re.abs() < 1e-9 * w[k] && (im - w[k]).abs() < 1e-9 * w[k], "{rows:?}");
     }
-    let mut sim = Simulator::new(&m, SimOptions { tol: 1e-10, max_step: None }, 0.0).unwrap();
+    let mut sim = Simulator::new(&m, SimOptions { tol: 1e-10, max_step: None, ..Default::default() }, 0.0).unwrap();
     let a0 = sim.outputs().unwrap()[0];
     assert!(a0.abs() < 1e-9, "hanging: theta1 = {a0}");
     sim.advance(1.0).unwrap();

@@ -83,7 +83,7 @@ const ELEMENTS: [(&str, ElementRef); 9] = [
 /// The mechanism after 0.3 s of motion (a moving, non-equilibrium point).
 fn moving() -> Simulator {
     let m = load_str(MECH, "loads.xml").unwrap_or_else(|e| panic!("{e}"));
-    let mut sim = Simulator::new(&m, SimOptions { tol: 1e-10, max_step: None }, 0.0).unwrap();
+    let mut sim = Simulator::new(&m, SimOptions { tol: 1e-10, max_step: None, ..Default::default() }, 0.0).unwrap();
     sim.advance(0.3).unwrap();
     sim
 }
@@ -96,7 +96,7 @@ fn load_outputs_c_and_d_match_central_differences_of_the_state_space_map() {
     // ~1e-12·|y'''|, round-off ~1e-16/1e-6·|y| ≈ 1e-9 for loads of ~10 N, so 1e-6 relative
     // to max(1, |entry|) is safe and still catches any missing term.
     let m = load_str(MECH, "loads.xml").unwrap_or_else(|e| panic!("{e}"));
-    let mut sim = Simulator::new(&m, SimOptions { tol: 1e-10, max_step: None }, 0.0).unwrap();
+    let mut sim = Simulator::new(&m, SimOptions { tol: 1e-10, max_step: None, ..Default::default() }, 0.0).unwrap();
     let sel = select_states(sim.system(), sim.q(), 0.0, &sim.inputs()).unwrap();
     assert_eq!(sel.states.len(), 5);
     sim.advance(0.3).unwrap();
@@ -244,7 +244,7 @@ fn a_pendulum_hinge_carries_its_weight_at_rest_and_the_centripetal_and_tangentia
     let (l, m, j, g) = (0.8, 1.5, 0.05, 9.81);
     // Hanging at rest: the hinge holds the weight, fz = m g, nothing else (1e-12 relative).
     let model = load_str(&pendulum(0.0, 0.0), "p.xml").unwrap_or_else(|e| panic!("{e}"));
-    let mut sim = Simulator::new(&model, SimOptions { tol: 1e-10, max_step: None }, 0.0).unwrap();
+    let mut sim = Simulator::new(&model, SimOptions { tol: 1e-10, max_step: None, ..Default::default() }, 0.0).unwrap();
     let y = sim.outputs().unwrap();
     assert!((y[2] - m * g).abs() < 1e-12 * m * g, "fz at rest = {} vs m g = {}", y[2], m * g);
     for (k, v) in y.iter().enumerate().filter(|(k, _)| *k != 2) {
@@ -257,7 +257,7 @@ fn a_pendulum_hinge_carries_its_weight_at_rest_and_the_centripetal_and_tangentia
     // the rod's principal axes keep tx = tz = 0).
     let (th, w) = (0.4f64, 2.0f64);
     let model = load_str(&pendulum(th, w), "p.xml").unwrap_or_else(|e| panic!("{e}"));
-    let mut sim = Simulator::new(&model, SimOptions { tol: 1e-10, max_step: None }, 0.0).unwrap();
+    let mut sim = Simulator::new(&model, SimOptions { tol: 1e-10, max_step: None, ..Default::default() }, 0.0).unwrap();
     let y = sim.outputs().unwrap();
     let r = [l * th.sin(), 0.0, -l * th.cos()];
     let wd = m * g * l * th.sin() / (j + m * l * l);

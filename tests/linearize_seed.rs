@@ -8,7 +8,7 @@ use mbfmu::model::parse::load_file;
 
 fn blade_eigen(file: &str) -> (Vec<String>, f64, f64) {
     let m = load_file(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models").join(file)).unwrap();
-    let mut sim = Simulator::new(&m, SimOptions { tol: 1e-10, max_step: None }, 0.0).unwrap();
+    let mut sim = Simulator::new(&m, SimOptions { tol: 1e-10, max_step: None, ..Default::default() }, 0.0).unwrap();
     let sel = select_states(sim.system(), sim.q(), 0.0, &sim.inputs()).unwrap();
     let lin = linearize(&mut sim, &sel, 2).unwrap();
     let rows = eigen_table(&lin.a).unwrap();

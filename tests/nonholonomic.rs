@@ -17,7 +17,7 @@ fn model(name: &str, params: &[(&str, f64)]) -> Model {
 }
 
 fn lin_at_start(m: &Model) -> Linearization {
-    let mut sim = Simulator::new(m, SimOptions { tol: 1e-10, max_step: None }, 0.0).unwrap();
+    let mut sim = Simulator::new(m, SimOptions { tol: 1e-10, max_step: None, ..Default::default() }, 0.0).unwrap();
     let sel = select_states(sim.system(), sim.q(), 0.0, &sim.inputs()).unwrap();
     linearize(&mut sim, &sel, 2).unwrap()
 }
@@ -97,7 +97,7 @@ fn rolling_disc_keeps_its_constraints_and_energy_over_ten_seconds() {
     // time, the contact height |C| below tol; energy to 1e-6 relative.
     let tol = 1e-8;
     let m = model("rolling_disc.xml", &[("lean_rate0", 0.3)]);
-    let mut sim = Simulator::new(&m, SimOptions { tol, max_step: None }, 0.0).unwrap();
+    let mut sim = Simulator::new(&m, SimOptions { tol, max_step: None, ..Default::default() }, 0.0).unwrap();
     let e0 = sim.mechanical_energy();
     let mut lean_max = 0.0f64;
     for k in 1..=200 {
@@ -138,7 +138,7 @@ fn static_equilibrium_with_a_knife_edge_across_a_slope() {
       <analysis static="true"/>
     </multibody>"#;
     let m = load_str_model(with_knife);
-    let mut sim = Simulator::new(&m, SimOptions { tol: 1e-10, max_step: None }, 0.0).unwrap();
+    let mut sim = Simulator::new(&m, SimOptions { tol: 1e-10, max_step: None, ..Default::default() }, 0.0).unwrap();
     let y0 = sim.outputs().unwrap();
     assert!((y0[0] - 0.5).abs() < 1e-9 && y0[1].abs() < 1e-9, "moved while solving: {y0:?}");
     sim.advance(1.0).unwrap();
@@ -151,7 +151,9 @@ fn static_equilibrium_with_a_knife_edge_across_a_slope() {
         .replace(r#"<analysis static="true"/>"#, "")
         .replace(r#"stiffness="50" damping="1""#, r#"stiffness="0" damping="0""#)
         .replace(r#"stiffness="5" damping="0.1""#, r#"stiffness="0" damping="0""#);
-    let mut sim = Simulator::new(&load_str_model(&free), SimOptions { tol: 1e-10, max_step: None }, 0.0).unwrap();
+    let mut sim =
+        Simulator::new(&load_str_model(&free), SimOptions { tol: 1e-10, max_step: None, ..Default::default() }, 0.0)
+            .unwrap();
     sim.advance(1.0).unwrap();
     let slid = -sim.outputs().unwrap()[1];
     let want = 0.5 * 9.81 * (20f64.to_radians()).sin() * (20f64.to_radians()).cos();

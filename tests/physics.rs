@@ -11,7 +11,7 @@ fn model(name: &str) -> Model {
 }
 
 fn sim(m: &Model, tol: f64) -> Simulator {
-    Simulator::new(m, SimOptions { tol, max_step: None }, 0.0).unwrap_or_else(|e| panic!("{e}"))
+    Simulator::new(m, SimOptions { tol, max_step: None, ..Default::default() }, 0.0).unwrap_or_else(|e| panic!("{e}"))
 }
 
 fn out(s: &mut Simulator, name: &str) -> f64 {

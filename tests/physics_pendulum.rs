@@ -41,7 +41,8 @@ fn pendulum_at_170_deg_has_the_elliptic_period() {
     let (m, g, l, jyy): (f64, f64, f64, f64) = (2.0, 9.81, 1.0, 0.3);
     let w0 = (m * g * l / (jyy + m * l * l)).sqrt();
     let period = 4.0 * ellip_k((theta0 / 2.0).sin()) / w0;
-    let mut sim = Simulator::new(&model, SimOptions { tol: 1e-10, max_step: None }, 0.0).expect("initializes");
+    let mut sim = Simulator::new(&model, SimOptions { tol: 1e-10, max_step: None, ..Default::default() }, 0.0)
+        .expect("initializes");
     sim.advance(0.5 * period).expect("integrates");
     let w = sim.outputs().unwrap()[0];
     // Near the turning point ω(T/2 + δt) ≈ θ̈ δt with |θ̈| = ω0² sin θ0, so δt = ω/|θ̈|.

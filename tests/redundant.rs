@@ -31,7 +31,7 @@ fn all_revolute_fourbar_moves_and_linearizes_like_the_non_redundant_one() {
     // Same motion to the integration tolerance (tol 1e-10 each: outputs agree to 1e-7 over
     // 1 s of this sensitive linkage) and the same A in the crank angle (1e-6 relative).
     let (base, revolutes) = fourbars();
-    let opts = SimOptions { tol: 1e-10, max_step: None };
+    let opts = SimOptions { tol: 1e-10, max_step: None, ..Default::default() };
     let ma = load_str(&base, "a.xml").unwrap();
     let mb = load_str(&revolutes, "b.xml").unwrap();
     assert_eq!(mb.summary().constraints, 20);

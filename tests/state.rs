@@ -12,7 +12,7 @@ fn model(name: &str) -> mbfmu::model::Model {
 #[test]
 fn restoring_a_snapshot_reproduces_the_run_bit_for_bit() {
     let m = model("double_pendulum.xml");
-    let opts = SimOptions { tol: 1e-8, max_step: None };
+    let opts = SimOptions { tol: 1e-8, max_step: None, ..Default::default() };
     let mut a = Simulator::new(&m, opts, 0.0).unwrap();
     a.advance(1.0).unwrap();
     let snap = a.snapshot();
@@ -53,7 +53,7 @@ fn held_and_interpolated_inputs_drive_a_rotor_exactly() {
     // [1, 2] (fmi2SetRealInputDerivatives): ω(2) = ω(1) + (2 + 3/2)/J. Polynomial motion:
     // the order-5 integrator is exact up to round-off.
     let m = mbfmu::model::parse::load_str(ROTOR, "rotor.xml").unwrap();
-    let mut s = Simulator::new(&m, SimOptions { tol: 1e-8, max_step: None }, 0.0).unwrap();
+    let mut s = Simulator::new(&m, SimOptions { tol: 1e-8, max_step: None, ..Default::default() }, 0.0).unwrap();
     let j = 0.5;
     s.set_input(0, 2.0);
     s.advance(1.0).unwrap();
@@ -75,7 +75,7 @@ fn output_derivatives_match_differences_of_the_outputs() {
         .unwrap()
         .replace("</multibody>", r#"<output name="tip_acc" function="accx(rod2.tip)"/><output name="tip_vz" function="vz(rod2.tip)"/></multibody>"#);
     let m = mbfmu::model::parse::load_str(&xml, "dp.xml").unwrap();
-    let opts = SimOptions { tol: 1e-12, max_step: None };
+    let opts = SimOptions { tol: 1e-12, max_step: None, ..Default::default() };
     let at = |t: f64| {
         let mut s = Simulator::new(&m, opts, 0.0).unwrap();
         s.advance(t).unwrap();

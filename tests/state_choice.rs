@@ -64,7 +64,7 @@ fn a_joint_angle_state_reads_the_angle_the_model_file_gives() {
     // pendulum.xml starts at th0 = 170° from the downward vertical, measured as
     // az(bob.P, ground.O) (its comment); the state hinge.angle must read exactly that.
     let (_, model) = example_variants().into_iter().find(|(n, _)| n == "pendulum.xml").unwrap();
-    let mut sim = Simulator::new(&model, SimOptions { tol: 1e-10, max_step: None }, 0.0).unwrap();
+    let mut sim = Simulator::new(&model, SimOptions { tol: 1e-10, max_step: None, ..Default::default() }, 0.0).unwrap();
     let sel = select_states(sim.system(), sim.q(), 0.0, &sim.inputs()).unwrap();
     let lin = linearize(&mut sim, &sel, 1).unwrap();
     assert_eq!(lin.states, ["hinge.angle", "der(hinge.angle)"]);
@@ -88,7 +88,7 @@ fn eigenvalues(model: &Model, which: Candidates) -> Option<Spectrum> {
     for j in &mut m.joints {
         (j.ic_speed, j.ic_angular_speed) = (None, None);
     }
-    let mut sim = Simulator::new(&m, SimOptions { tol: 1e-10, max_step: None }, t0).ok()?;
+    let mut sim = Simulator::new(&m, SimOptions { tol: 1e-10, max_step: None, ..Default::default() }, t0).ok()?;
     let (udot, _) = sim.accelerations().ok()?;
     // An equilibrium: at rest and not accelerating (a driven model is neither).
     let moving = sim.u().iter().chain(&udot).fold(0.0f64, |a, v| a.max(v.abs()));
@@ -168,7 +168,8 @@ fn a_motion_leaves_its_joints_other_coordinate_as_the_state() {
     // The driven rotation is no degree of freedom: the cylindrical joint's displacement is
     // the only state, and the axial spring gives λ = ±i·sqrt(k/m) = ±10i (exact: the
     // translation does not couple with the rotation about the same axis).
-    let mut sim = Simulator::new(&cylinder(true), SimOptions { tol: 1e-10, max_step: None }, 0.0).unwrap();
+    let mut sim =
+        Simulator::new(&cylinder(true), SimOptions { tol: 1e-10, max_step: None, ..Default::default() }, 0.0).unwrap();
     let sel = select_states(sim.system(), sim.q(), 0.0, &sim.inputs()).unwrap();
     let lin = linearize(&mut sim, &sel, 1).unwrap();
     assert_eq!(lin.states, ["cyl.displacement", "der(cyl.displacement)"]);
@@ -181,7 +182,8 @@ fn a_motion_leaves_its_joints_other_coordinate_as_the_state() {
 fn a_joint_angle_state_is_continuous_through_pi() {
     // Free spin at 10 rad/s: after 1 s the angle state reads 10 rad (not 10 − 4π), and its
     // rate 10 rad/s; the integrator's tolerance 1e-10 bounds the error.
-    let mut sim = Simulator::new(&cylinder(false), SimOptions { tol: 1e-10, max_step: None }, 0.0).unwrap();
+    let mut sim =
+        Simulator::new(&cylinder(false), SimOptions { tol: 1e-10, max_step: None, ..Default::default() }, 0.0).unwrap();
     let sel = select_states(sim.system(), sim.q(), 0.0, &sim.inputs()).unwrap();
     let names: Vec<&str> = sel.states.iter().map(|s| s.name.as_str()).collect();
     assert_eq!(names, ["cyl.angle", "cyl.displacement"]);

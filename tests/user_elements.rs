@@ -13,7 +13,7 @@ fn model_path(name: &str) -> std::path::PathBuf {
 }
 
 fn lin_at_start(m: &Model) -> Linearization {
-    let mut sim = Simulator::new(m, SimOptions { tol: 1e-10, max_step: None }, 0.0).unwrap();
+    let mut sim = Simulator::new(m, SimOptions { tol: 1e-10, max_step: None, ..Default::default() }, 0.0).unwrap();
     let sel = select_states(sim.system(), sim.q(), 0.0, &sim.inputs()).unwrap();
     linearize(&mut sim, &sel, 2).unwrap()
 }
@@ -150,7 +150,7 @@ fn pid_loop_simulates_back_to_upright_like_its_linearization() {
         &format!(r#"position="a*sin({th0}) 0 a*cos({th0})" euler313="pi/2 {th0} -pi/2">"#),
     );
     let m = load_str(&text, "c.xml").unwrap();
-    let mut sim = Simulator::new(&m, SimOptions { tol: 1e-10, max_step: None }, 0.0).unwrap();
+    let mut sim = Simulator::new(&m, SimOptions { tol: 1e-10, max_step: None, ..Default::default() }, 0.0).unwrap();
     let y0 = sim.outputs().unwrap();
     assert!((y0[1] - th0).abs() < 1e-12, "initial angle {}", y0[1]);
     let mut x = [0.0, th0, 0.0, 0.0, 0.0];
@@ -213,7 +213,7 @@ fn added_mass_case(ma: f64) {
     let rows = eigen_table(&lin.a).unwrap();
     assert_eq!(rows.len(), 1, "{rows:?}");
     assert!((rows[0].im.abs() - w).abs() < 1e-9 * w && rows[0].re.abs() < 1e-9 * w, "{rows:?}");
-    let mut sim = Simulator::new(&m, SimOptions { tol: 1e-10, max_step: None }, 0.0).unwrap();
+    let mut sim = Simulator::new(&m, SimOptions { tol: 1e-10, max_step: None, ..Default::default() }, 0.0).unwrap();
     for k in 1..=20 {
         let t = 0.1 * k as f64;
         sim.advance(t).unwrap();
@@ -248,7 +248,7 @@ fn static_equilibrium_solves_for_the_controller_state_too() {
       <analysis static="true"/>
     </multibody>"#;
     let m = load_str(xml, "held.xml").unwrap();
-    let sim = Simulator::new(&m, SimOptions { tol: 1e-10, max_step: None }, 0.0).unwrap();
+    let sim = Simulator::new(&m, SimOptions { tol: 1e-10, max_step: None, ..Default::default() }, 0.0).unwrap();
     let mut sim = sim;
     let y = sim.outputs().unwrap();
     let want_x = -9.81 * 0.5 * 0.3f64.sin() / 5.0; // m = 1

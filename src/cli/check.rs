@@ -14,8 +14,11 @@ use crate::model::parse::load_file;
 pub fn check(path: &Path, out: &mut dyn Write) -> Result<(), CliError> {
     let model = load_file(path)?;
     let t0 = model.experiment.start.unwrap_or(0.0);
-    let sim =
-        Simulator::new(&model, SimOptions { tol: model.experiment.tolerance.unwrap_or(1e-8), max_step: None }, t0)?;
+    let sim = Simulator::new(
+        &model,
+        SimOptions { tol: model.experiment.tolerance.unwrap_or(1e-8), max_step: None, ..Default::default() },
+        t0,
+    )?;
     super::print_warnings(&sim);
     let c = counts(sim.system(), sim.q(), sim.u(), t0, &sim.inputs(), &sim.ext());
     writeln!(out, "model '{}' ({}): ok", model.name, path.display())

@@ -9,7 +9,7 @@ use clap::Args;
 
 use super::CliError;
 use super::input_csv::InputTable;
-use crate::dae::{SimOptions, Simulator};
+use crate::dae::{DEFAULT_MAX_STEPS, SimOptions, Simulator};
 use crate::linearize::eigen::{eigen_table, format_table};
 use crate::linearize::{Linearization, Selection, linearize, select_states, state_values};
 use crate::model::parse::load_file;
@@ -31,6 +31,10 @@ pub struct LinearizeArgs {
     /// Integration tolerance (default: the experiment's, else 1e-8).
     #[arg(long)]
     pub tol: Option<f64>,
+    /// Most integrator step attempts on the way to each time (and between input rows);
+    /// more is an error at the time reached (as the FMU's solver.maxSteps).
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_MAX_STEPS, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..))]
+    pub max_steps: usize,
     /// Find static equilibrium first (as `<analysis static="true"/>`).
     #[arg(long = "static")]
     pub r#static: bool,
@@ -67,7 +71,7 @@ pub fn run(args: &LinearizeArgs, out: &mut dyn Write, report: &mut dyn Write) ->
     if let Some(t) = &table {
         t.set_start(&mut model, t0);
     }
-    let mut sim = Simulator::new(&model, SimOptions { tol, max_step: None }, t0)?;
+    let mut sim = Simulator::new(&model, SimOptions { tol, max_step: None, max_steps: args.max_steps }, t0)?;
     if let Some(t) = &table {
         t.apply(&mut sim)?;
     }

@@ -35,7 +35,7 @@ pub fn run(out: &mut dyn Write) -> Result<(), CliError> {
         }
     }
     let at_rest = model.with_params(&p).map_err(CliError::Usage)?;
-    let mut sim = Simulator::new(&at_rest, SimOptions { tol: 1e-10, max_step: None }, 0.0)?;
+    let mut sim = Simulator::new(&at_rest, SimOptions { tol: 1e-10, max_step: None, ..Default::default() }, 0.0)?;
     let sel = select_states(sim.system(), sim.q(), 0.0, &sim.inputs()).map_err(|e| CliError::Engine(e.into()))?;
     let lin = linearize(&mut sim, &sel, 2)?;
     let rows = eigen_table(&lin.a).map_err(|e| CliError::Engine(e.into()))?;
@@ -45,7 +45,7 @@ pub fn run(out: &mut dyn Write) -> Result<(), CliError> {
     writeln!(out).map_err(io_err)?;
     let settings = RunSettings::resolve(&model, Some(RUN_END), Some(RUN_STEP), None)?;
     let points = settings.points()?;
-    let opts = SimOptions { tol: settings.tol, max_step: None };
+    let opts = SimOptions { tol: settings.tol, max_step: None, ..Default::default() };
     let mut sim = Simulator::new(&model, opts, settings.start)?;
 
     writeln!(

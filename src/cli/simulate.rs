@@ -1,4 +1,4 @@
-//! `mbfmu simulate model.xml [--end T] [--step H] [--tol E] [--out result.csv] [--states]`:
+//! `mbfmu simulate model.xml [--end T] [--step H] [--tol E] [--max-steps N] [--out result.csv] [--states]`:
 //! simulate and write time, every output (and every q and u) as CSV.
 
 use std::fs::File;
@@ -9,7 +9,7 @@ use clap::Args;
 
 use super::CliError;
 use super::input_csv::InputTable;
-use crate::dae::{SimOptions, Simulator};
+use crate::dae::{DEFAULT_MAX_STEPS, SimOptions, Simulator};
 use crate::model::Model;
 use crate::model::parse::load_file;
 
@@ -32,6 +32,10 @@ pub struct SimulateArgs {
     /// Integrator tolerance (default: the model's <experiment tolerance>, else 1e-6).
     #[arg(long, value_name = "E", allow_negative_numbers = true)]
     pub tol: Option<f64>,
+    /// Most integrator step attempts per communication step; more is an error at the time
+    /// reached (as the FMU's solver.maxSteps).
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_MAX_STEPS, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..))]
+    pub max_steps: usize,
     /// Write the CSV to this file instead of stdout.
     #[arg(long, value_name = "FILE")]
     pub out: Option<PathBuf>,
@@ -166,7 +170,7 @@ pub fn simulate(args: &SimulateArgs, stdout: &mut dyn Write) -> Result<(), CliEr
     model.static_analysis |= args.r#static;
     let settings = RunSettings::resolve(&model, args.end, args.step, args.tol)?;
     let points = settings.points()?;
-    let opts = SimOptions { tol: settings.tol, max_step: None };
+    let opts = SimOptions { tol: settings.tol, max_step: None, max_steps: args.max_steps };
     let table = args.input.as_deref().map(|p| InputTable::read(p, &model)).transpose()?;
     if let Some(t) = &table {
         t.set_start(&mut model, settings.start);

@@ -2,6 +2,7 @@
 
 use super::equations::{self, Layout};
 use super::init;
+use super::radau::DEFAULT_MAX_STEPS;
 use super::radau::{DaeProblem, Radau, Stats};
 use super::sparse::{SparseLu, Triplets};
 use crate::ad::Real;
@@ -40,11 +41,14 @@ pub struct SimOptions {
     pub tol: f64,
     /// Largest step the integrator may take (None: unlimited).
     pub max_step: Option<f64>,
+    /// Most integrator step attempts (accepted and rejected) per [`Simulator::advance`]
+    /// call; more is an error at the time reached (default [`DEFAULT_MAX_STEPS`]).
+    pub max_steps: usize,
 }
 
 impl Default for SimOptions {
     fn default() -> Self {
-        SimOptions { tol: 1e-6, max_step: None }
+        SimOptions { tol: 1e-6, max_step: None, max_steps: DEFAULT_MAX_STEPS }
     }
 }
 
@@ -356,6 +360,7 @@ impl Simulator {
         if let Some(h) = opts.max_step {
             radau.max_step = h;
         }
+        radau.max_steps = opts.max_steps.max(1);
         let warnings = assembly_moves(model, &sys_q0, &assembled);
         Ok(Simulator { dae, radau, acc_lu, acc: Some((udot, lam)), warnings })
     }
@@ -365,7 +370,20 @@ impl Simulator {
         self.radau.t
     }
 
-    /// Integrate to `t_end` exactly (the last step lands on it).
+    /// Change the limit on integrator step attempts per [`Simulator::advance`] call (at
+    /// least 1).
+    pub fn set_max_steps(&mut self, n: usize) {
+        self.radau.max_steps = n.max(1);
+    }
+
+    /// The limit on integrator step attempts per [`Simulator::advance`] call.
+    pub fn max_steps(&self) -> usize {
+        self.radau.max_steps
+    }
+
+    /// Integrate to `t_end` exactly (the last step lands on it). On an error (the step
+    /// limit, a step-size collapse) the simulation stays at the last accepted step:
+    /// [`Simulator::time`] is the time reached.
     pub fn advance(&mut self, t_end: f64) -> Result<(), EngineError> {
         if t_end < self.radau.t {
             return Err(EngineError::Numeric(format!("cannot integrate backwards from {} to {t_end}", self.radau.t)));

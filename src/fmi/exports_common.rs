@@ -208,11 +208,47 @@ pub unsafe extern "C" fn fmi2SetReal(
     })
 }
 
-/// The model has only Real variables: any value reference of another type is unknown.
+/// fmi2GetInteger (2.1.7): the Integer parameter `solver.maxSteps`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2GetInteger(
+    c: Component,
+    vr: *const ValueReference,
+    nvr: size_t,
+    value: *mut Integer,
+) -> Status {
+    guarded(c, Func::GetInteger, |inst| {
+        // SAFETY: nvr elements each, per FMI.
+        let (vr, value) = unsafe { (slice(vr, nvr, "vr")?, slice_mut(value, nvr, "value")?) };
+        inst.get_integers(vr, value)?;
+        Ok(Status::Ok)
+    })
+}
+
+/// fmi2SetInteger (2.1.7): `solver.maxSteps` (tunable: also between steps), at least 1.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi2SetInteger(
+    c: Component,
+    vr: *const ValueReference,
+    nvr: size_t,
+    value: *const Integer,
+) -> Status {
+    guarded(c, Func::SetInteger, |inst| {
+        // SAFETY: nvr elements each, per FMI.
+        let (vr, value) = unsafe { (slice(vr, nvr, "vr")?, slice(value, nvr, "value")?) };
+        inst.set_integers(vr, value)?;
+        Ok(Status::Ok)
+    })
+}
+
+/// The model has no Boolean or String variables: any value reference of those types is
+/// unknown.
 fn no_such(func: Func, vr: &[ValueReference]) -> Result<Status, String> {
     match vr.first() {
         None => Ok(Status::Ok),
-        Some(v) => Err(format!("unknown value reference {v} (the FMU has only Real variables; {})", func.name())),
+        Some(v) => Err(format!(
+            "unknown value reference {v} (the FMU has only Real variables and the Integer solver.maxSteps; {})",
+            func.name()
+        )),
     }
 }
 
@@ -235,14 +271,10 @@ macro_rules! no_variables {
 }
 
 no_variables! {
-    /// fmi2GetInteger (2.1.7): no Integer variables.
-    fmi2GetInteger, Func::GetInteger, *mut Integer;
     /// fmi2GetBoolean (2.1.7): no Boolean variables.
     fmi2GetBoolean, Func::GetBoolean, *mut Boolean;
     /// fmi2GetString (2.1.7): no String variables.
     fmi2GetString, Func::GetString, *mut FmiString;
-    /// fmi2SetInteger (2.1.7): no Integer variables.
-    fmi2SetInteger, Func::SetInteger, *const Integer;
     /// fmi2SetBoolean (2.1.7): no Boolean variables.
     fmi2SetBoolean, Func::SetBoolean, *const Boolean;
     /// fmi2SetString (2.1.7): no String variables.

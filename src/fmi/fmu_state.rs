@@ -5,7 +5,7 @@ use super::instance::{Config, Instance};
 use super::state_machine::State;
 use crate::dae::SimState;
 
-const MAGIC: &[u8; 8] = b"MBFMUF01";
+const MAGIC: &[u8; 8] = b"MBFMUF02";
 
 /// Everything fmi2SetFMUstate needs to put an instance of the same model back.
 #[derive(Clone, Debug, PartialEq)]
@@ -20,11 +20,15 @@ pub struct FmuState {
 }
 
 impl FmuState {
-    /// fmi2GetFMUstate.
+    /// fmi2GetFMUstate. A state taken after fmi2DoStep returned fmi2Discard (StepFailed)
+    /// holds the engine at fmi2LastSuccessfulTime, the last accepted integrator step, which
+    /// is a valid communication point: it is recorded as StepComplete, so that restoring
+    /// it lets the host continue from the time reached (e.g. with a larger
+    /// `solver.maxSteps` or a shorter step).
     pub fn capture(inst: &Instance) -> FmuState {
         FmuState {
             guid: inst.guid.clone(),
-            state: inst.state,
+            state: if inst.state == State::StepFailed { State::StepComplete } else { inst.state },
             config: inst.config.clone(),
             last_time: inst.last_time,
             sim: if inst.dirty { None } else { inst.built.as_ref().map(|b| b.sim.snapshot()) },
@@ -48,7 +52,9 @@ impl FmuState {
                 if !reusable {
                     inst.built = Some(inst.build(&self.config)?);
                 }
-                inst.built.as_mut().expect("built").sim.restore(s).map_err(|e| e.to_string())?;
+                let sim = &mut inst.built.as_mut().expect("built").sim;
+                sim.restore(s).map_err(|e| e.to_string())?;
+                sim.set_max_steps(self.config.max_steps);
                 inst.dirty = false;
             }
         }
@@ -58,7 +64,8 @@ impl FmuState {
         Ok(())
     }
 
-    /// fmi2SerializeFMUstate: magic, GUID, state, configuration, engine state.
+    /// fmi2SerializeFMUstate: magic, GUID, state, configuration (with `solver.maxSteps`),
+    /// engine state.
     pub fn to_bytes(&self) -> Vec<u8> {
         let mut w = Writer(MAGIC.to_vec());
         w.bytes(self.guid.as_bytes());
@@ -69,6 +76,7 @@ impl FmuState {
         w.f64s(&c.params);
         w.f64s(&c.inputs);
         w.f64s(&c.slopes);
+        w.0.extend_from_slice(&(c.max_steps as u64).to_le_bytes());
         match &self.sim {
             Some(s) => {
                 w.0.push(1);
@@ -89,6 +97,7 @@ impl FmuState {
         let has_stop = r.byte().ok_or_else(bad)? == 1;
         let (params, inputs, slopes) =
             (r.f64s().ok_or_else(bad)?, r.f64s().ok_or_else(bad)?, r.f64s().ok_or_else(bad)?);
+        let max_steps = r.len().filter(|&n| n >= 1).ok_or_else(bad)?;
         let sim = match r.byte().ok_or_else(bad)? {
             0 => None,
             1 => Some(SimState::from_bytes(r.bytes().ok_or_else(bad)?).map_err(|e| e.to_string())?),
@@ -98,7 +107,7 @@ impl FmuState {
             return Err(bad());
         }
         let stop = has_stop.then_some(head[2]);
-        let config = Config { params, inputs, slopes, tol: head[0], start: head[1], stop };
+        let config = Config { params, inputs, slopes, tol: head[0], start: head[1], stop, max_steps };
         Ok(FmuState { guid, state, config, last_time: head[3], sim })
     }
 }

@@ -6,11 +6,12 @@ use super::logger::Logger;
 use super::state_machine::State;
 use super::types::Status;
 use super::variables::{Target, Variable, variables};
-use crate::dae::{SimOptions, SimState, Simulator};
+use crate::dae::{DEFAULT_MAX_STEPS, SimOptions, SimState, Simulator};
 use crate::linearize::{Linearization, Selection, linearize, selection_by_name, state_values};
 use crate::model::Model;
 
-/// What the host chose: parameter and input values, input slopes, experiment.
+/// What the host chose: parameter and input values, input slopes, experiment, solver
+/// settings.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Config {
     pub params: Vec<f64>,
@@ -19,6 +20,8 @@ pub struct Config {
     pub tol: f64,
     pub start: f64,
     pub stop: Option<f64>,
+    /// `solver.maxSteps`: most integrator step attempts per fmi2DoStep (at least 1).
+    pub max_steps: usize,
 }
 
 /// The engine, with the configuration it was built from.
@@ -72,6 +75,7 @@ impl Instance {
             tol: m.experiment.tolerance.unwrap_or(SimOptions::default().tol),
             start: m.experiment.start.unwrap_or(0.0),
             stop: None,
+            max_steps: DEFAULT_MAX_STEPS,
         }
     }
 
@@ -139,8 +143,9 @@ impl Instance {
         for (i, &v) in model.inputs.iter_mut().zip(&cfg.inputs) {
             i.start.value = v;
         }
-        let mut sim = Simulator::new(&model, SimOptions { tol: cfg.tol, max_step: None }, cfg.start)
-            .map_err(|e| format!("the model cannot be initialized: {e}"))?;
+        let mut sim =
+            Simulator::new(&model, SimOptions { tol: cfg.tol, max_step: None, max_steps: cfg.max_steps }, cfg.start)
+                .map_err(|e| format!("the model cannot be initialized: {e}"))?;
         for (k, &s) in cfg.slopes.iter().enumerate() {
             if s != 0.0 {
                 sim.set_input_derivative(k, s);
@@ -161,9 +166,62 @@ impl Instance {
         Ok(Built { sim, params: cfg.params.clone(), tol: cfg.tol, sel, lin: None })
     }
 
+    /// The variable of value reference `vr`, which must be of FMI type Integer (`integer`)
+    /// or Real.
+    fn typed_var(&self, vr: u32, integer: bool) -> Result<&Variable, String> {
+        let v = self.var(vr)?;
+        match (v.target.is_integer(), integer) {
+            (true, false) => {
+                Err(format!("'{}' (vr {vr}) is an Integer variable (use fmi2GetInteger/fmi2SetInteger)", v.name))
+            }
+            (false, true) => Err(format!("'{}' (vr {vr}) is a Real variable, not an Integer", v.name)),
+            _ => Ok(v),
+        }
+    }
+
+    /// fmi2GetInteger: values of `vrs` (only `solver.maxSteps`) into `out`.
+    pub fn get_integers(&self, vrs: &[u32], out: &mut [i32]) -> Result<(), String> {
+        for (&vr, o) in vrs.iter().zip(out.iter_mut()) {
+            match self.typed_var(vr, true)?.target {
+                Target::MaxSteps => *o = i32::try_from(self.config.max_steps).unwrap_or(i32::MAX),
+                t => unreachable!("{t:?} is not an Integer variable"),
+            }
+        }
+        Ok(())
+    }
+
+    /// fmi2SetInteger: `solver.maxSteps` (at least 1) at any time the state machine allows
+    /// (it is tunable: a change after initialization holds from the next fmi2DoStep). All
+    /// checked first, then all applied.
+    pub fn set_integers(&mut self, vrs: &[u32], values: &[i32]) -> Result<(), String> {
+        for (&vr, &v) in vrs.iter().zip(values) {
+            let var = self.typed_var(vr, true)?;
+            if v < 1 {
+                return Err(format!(
+                    "value {v} for '{}' (vr {vr}) is not a positive number of integrator steps",
+                    var.name
+                ));
+            }
+        }
+        for (&vr, &v) in vrs.iter().zip(values) {
+            match self.typed_var(vr, true)?.target {
+                Target::MaxSteps => {
+                    let n = usize::try_from(v).expect("checked positive");
+                    self.config.max_steps = n;
+                    if let Some(b) = self.built.as_mut() {
+                        b.sim.set_max_steps(n);
+                    }
+                }
+                t => unreachable!("{t:?} is not an Integer variable"),
+            }
+        }
+        Ok(())
+    }
+
     /// fmi2GetReal: values of `vrs` into `out`.
     pub fn get_reals(&mut self, vrs: &[u32], out: &mut [f64]) -> Result<(), String> {
-        let targets = vrs.iter().map(|&vr| Ok(self.var(vr)?.target)).collect::<Result<Vec<Target>, String>>()?;
+        let targets =
+            vrs.iter().map(|&vr| Ok(self.typed_var(vr, false)?.target)).collect::<Result<Vec<Target>, String>>()?;
         let mut outputs = None;
         let mut inputs = None;
         let mut states: Option<crate::linearize::StateValues> = None;
@@ -208,6 +266,7 @@ impl Instance {
                         _ => z[2 * nx + k],
                     }
                 }
+                Target::MaxSteps => unreachable!("refused above: an Integer variable"),
             };
         }
         Ok(())
@@ -222,7 +281,7 @@ impl Instance {
     pub fn set_reals(&mut self, vrs: &[u32], values: &[f64]) -> Result<(), String> {
         let mut targets = Vec::with_capacity(vrs.len());
         for (&vr, &v) in vrs.iter().zip(values) {
-            let var = self.var(vr)?;
+            let var = self.typed_var(vr, false)?;
             if !v.is_finite() {
                 return Err(format!("value {v} for '{}' (vr {vr}) is not finite", var.name));
             }

@@ -153,6 +153,9 @@ fn write_experiment(x: &mut String, model: &Model) {
 
 fn write_variable(x: &mut String, index: usize, v: &Variable) {
     let (causality, variability, initial) = match v.causality {
+        // Solver settings may change between steps; model parameters only before
+        // initialization ends.
+        Causality::Parameter if v.target.is_integer() => ("parameter", "tunable", Some("exact")),
         Causality::Parameter => ("parameter", "fixed", Some("exact")),
         Causality::Input => ("input", "continuous", None),
         Causality::Output => ("output", "continuous", Some("calculated")),
@@ -170,6 +173,14 @@ fn write_variable(x: &mut String, index: usize, v: &Variable) {
     }
     if let Some(d) = &v.description {
         let _ = write!(x, " description=\"{}\"", escape(d));
+    }
+    if v.target.is_integer() {
+        x.push_str(">\n      <Integer");
+        if let Some(s) = v.start {
+            let _ = write!(x, " start=\"{}\"", s as i64);
+        }
+        x.push_str("/>\n    </ScalarVariable>\n");
+        return;
     }
     x.push_str(">\n      <Real");
     if let Some(k) = v.derivative {

@@ -3,12 +3,18 @@
 //! `der(S)` (the velocity states W where W = Ṡ), velocity states that are not such a
 //! derivative (non-holonomic models: user `<velocity>`s), the velocity derivatives
 //! `der(S,2)` / `der(W)`, then the differential states X, `der(X)` and the user variables
-//! V, numbered consecutively from 0 in model order. The
-//! packer writes them into modelDescription.xml and the C API resolves value references
-//! with them, so both always agree.
+//! V, numbered consecutively from 0 in model order; last the solver settings (the Integer
+//! parameter `solver.maxSteps`: a model name has no '.', so it cannot collide, and being
+//! last it shifts no other value reference). The packer writes them into
+//! modelDescription.xml and the C API resolves value references with them, so both
+//! always agree.
 
+use crate::dae::DEFAULT_MAX_STEPS;
 use crate::model::Model;
 use crate::model::units::per_second;
+
+/// Name of the Integer parameter that bounds the integrator step attempts per fmi2DoStep.
+pub const MAX_STEPS_NAME: &str = "solver.maxSteps";
 
 /// FMI causality of a variable.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -43,16 +49,25 @@ pub enum Target {
     DiffDerivative(usize),
     /// User variable V_k (`<variable>`).
     UserVariable(usize),
+    /// `solver.maxSteps` (Integer, tunable): most integrator step attempts per fmi2DoStep.
+    MaxSteps,
 }
 
-/// One FMI scalar variable (all are Real).
+impl Target {
+    /// Whether the variable is an FMI Integer (else Real).
+    pub fn is_integer(self) -> bool {
+        matches!(self, Target::MaxSteps)
+    }
+}
+
+/// One FMI scalar variable (Real, except `solver.maxSteps`: see [`Target::is_integer`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Variable {
     pub name: String,
     pub value_reference: u32,
     pub causality: Causality,
     pub target: Target,
-    /// Start value (parameters and inputs).
+    /// Start value (parameters and inputs; an Integer's is a whole number).
     pub start: Option<f64>,
     pub unit: Option<String>,
     pub description: Option<String>,
@@ -207,6 +222,22 @@ pub fn variables(model: &Model) -> Vec<Variable> {
         x.description = Some("user variable (seed Eq. 7b)".into());
         v.push(x);
     }
+    v.push(Variable {
+        name: MAX_STEPS_NAME.into(),
+        value_reference: v.len() as u32,
+        causality: Causality::Parameter,
+        target: Target::MaxSteps,
+        start: Some(DEFAULT_MAX_STEPS as f64),
+        unit: None,
+        description: Some(format!(
+            "most internal integrator steps (accepted and rejected) per fmi2DoStep, like CVODE's mxstep \
+             (default {DEFAULT_MAX_STEPS}); a step that needs more returns fmi2Discard with \
+             fmi2LastSuccessfulTime = the time reached; at least 1, tunable between steps"
+        )),
+        derivative: None,
+        known: None,
+        unknown: None,
+    });
     v
 }
 

@@ -27,7 +27,7 @@ use states::{VelState, internal_state, joint_states, user_states};
 pub fn selection_at_start(model: &Model) -> Result<Selection, EngineError> {
     let t0 = model.experiment.start.unwrap_or(0.0);
     let tol = model.experiment.tolerance.unwrap_or(SimOptions::default().tol);
-    let sim = Simulator::new(model, SimOptions { tol, max_step: None }, t0)?;
+    let sim = Simulator::new(model, SimOptions { tol, max_step: None, ..Default::default() }, t0)?;
     select_states(sim.system(), sim.q(), t0, &sim.inputs()).map_err(EngineError::Numeric)
 }
 

@@ -62,11 +62,16 @@ def test_packed_fmu_validates(model: Path, tmp_path: Path):
 
     # The variables are the model's parameters, inputs and outputs, in file order, then the
     # linearization states S, their velocities der(S) and accelerations der(S,2) (in general
-    # der(W)), then X, der(X), V; value references 0, 1, 2, ...
+    # der(W)), then X, der(X), V, and last the Integer solver.maxSteps; value references
+    # 0, 1, 2, ...
     root = ET.parse(model).getroot()
     expected = [(e.get("name"), c) for tag, c in (("parameter", "parameter"), ("input", "input"), ("output", "output"))
                 for e in root.iter(tag)]
-    actual = [(v.name, v.causality) for v in md.modelVariables]
+    last = md.modelVariables[-1]
+    assert (last.name, last.type, last.causality, last.variability) == (
+        "solver.maxSteps", "Integer", "parameter", "tunable")
+    assert all(v.type == "Real" for v in md.modelVariables[:-1])
+    actual = [(v.name, v.causality) for v in md.modelVariables[:-1]]
     assert actual[: len(expected)] == expected
     local = [name for name, c in actual[len(expected):]]
     assert all(c == "local" for _, c in actual[len(expected):])
@@ -87,7 +92,7 @@ def test_packed_fmu_validates(model: Path, tmp_path: Path):
     assert all(descr[n] for n in lin[:s] + extra)
     if not root.findall("rolling_wheel") + root.findall("knife_edge") + root.findall("velocity_constraint"):
         assert extra == [] and lin[2 * s:] == [f"der({n},2)" for n in lin[:s]]
-    assert [v.valueReference for v in md.modelVariables] == list(range(len(actual)))
+    assert [v.valueReference for v in md.modelVariables] == list(range(len(actual) + 1))
     assert md.defaultExperiment is not None
 
     # Every unit used is defined (validate_fmu checks it too) and none is unused.
