@@ -385,3 +385,25 @@ case!(
     "64_sforce_reads_own_load.xml",
     "64_sforce_reads_own_load.xml:4:55: sforce 's': 'function' reads the load of sforce 's' (line 4), which reads loads itself; forces and user elements may read only loads that read no loads"
 );
+
+// A UTF-8 byte order mark (fuzz input EF BB BF 0A 0A 3C 0A was reported at 1:3, past the
+// end of line 1): positions from the XML reader counted from after the mark, 3 bytes
+// early; and the mark is no column.
+
+case!(
+    m65_bom_malformed_xml,
+    "65_bom_malformed_xml.xml",
+    "65_bom_malformed_xml.xml:3:3: xml 'document': malformed XML: ill-formed document: expected `</body>`, but `</bodyx>` was found"
+);
+
+case!(
+    m66_bom_unexpected_text,
+    "66_bom_unexpected_text.xml",
+    "66_bom_unexpected_text.xml:3:3: multibody 'm': unexpected text"
+);
+
+case!(
+    m67_bom_bad_version,
+    "67_bom_bad_version.xml",
+    "67_bom_bad_version.xml:1:21: multibody 'm': unsupported version '2' (this reader knows version \"1\")"
+);

@@ -16,11 +16,14 @@ impl<'t> Source<'t> {
         Source { file: file.to_string(), text, line_starts }
     }
 
-    /// Line and column (in characters, both 1-based) of byte offset `off`.
+    /// Line and column (in characters, both 1-based) of byte offset `off`. A UTF-8 byte
+    /// order mark is not a column: editors do not show it.
     pub fn pos(&self, off: usize) -> SrcPos {
         let off = off.min(self.text.len());
         let line = self.line_starts.partition_point(|&s| s <= off).max(1);
-        let start = self.line_starts[line - 1];
+        let bom = if line == 1 && self.text.starts_with('\u{feff}') { '\u{feff}'.len_utf8() } else { 0 };
+        let start = self.line_starts[line - 1] + bom;
+        let off = off.max(start);
         let col = self.text.get(start..off).map_or(off - start, |s| s.chars().count()) + 1;
         SrcPos { line, col }
     }

@@ -42,15 +42,20 @@ const MAX_DEPTH: usize = 32;
 
 /// Parse the whole text; returns the single root element.
 pub(crate) fn read(src: &Source) -> Result<XElem, ModelError> {
-    let mut reader = Reader::from_str(src.text);
+    // The reader gets the text after a UTF-8 byte order mark, and `base` turns its
+    // offsets back into offsets of the whole text (quick-xml would skip the mark itself
+    // and count from after it, putting every position it reports 3 bytes early).
+    let body = src.text.strip_prefix('\u{feff}').unwrap_or(src.text);
+    let base = src.text.len() - body.len();
+    let mut reader = Reader::from_str(body);
     let mut stack: Vec<XElem> = Vec::new();
     let mut root: Option<XElem> = None;
     loop {
-        let before = usize::try_from(reader.buffer_position()).unwrap_or(0);
+        let before = base + usize::try_from(reader.buffer_position()).unwrap_or(0);
         let ev = match reader.read_event() {
             Ok(ev) => ev,
             Err(e) => {
-                let at = usize::try_from(reader.error_position()).unwrap_or(0);
+                let at = base + usize::try_from(reader.error_position()).unwrap_or(0);
                 return Err(src.error(src.pos(at), "xml", "document", format!("malformed XML: {e}")));
             }
         };
