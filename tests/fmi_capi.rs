@@ -413,3 +413,133 @@ fn a_panic_inside_an_export_becomes_fatal_when_the_engine_may_be_corrupt_and_err
     free(c);
     free(d);
 }
+
+/// Value references of the knowns (states, inputs) and unknowns (state derivatives,
+/// outputs) of the linearization.
+fn lin_refs(text: &str) -> (Vec<u32>, Vec<u32>) {
+    use mbfmu::fmi::variables::{Causality, variables};
+    let vars = variables(&mbfmu::model::parse::load_str(text, "model.xml").unwrap());
+    let pick = |f: &dyn Fn(&mbfmu::fmi::variables::Variable) -> bool| {
+        vars.iter().filter(|v| f(v)).map(|v| v.value_reference).collect::<Vec<u32>>()
+    };
+    (
+        pick(&|v| v.known.is_some() || v.causality == Causality::Input),
+        pick(&|v| v.unknown.is_some() || v.causality == Causality::Output),
+    )
+}
+
+/// Instantiate, initialize, step, read every column of A/B/C/D, and round-trip an FMU
+/// state: every export the engine runs in.
+fn full_run(text: &str, knowns: &[u32], unknowns: &[u32]) -> Vec<f64> {
+    let c = initialized(text, 1e-8, &[]);
+    let t = step(c, 0.0, 0.01, 2);
+    let mut out = Vec::new();
+    // SAFETY: a live instance and arrays of the stated lengths throughout.
+    unsafe {
+        let mut s = std::ptr::null_mut();
+        assert_eq!(fmi2GetFMUstate(c, &mut s), Status::Ok);
+        step(c, t, 0.01, 1);
+        assert_eq!(fmi2SetFMUstate(c, s), Status::Ok);
+        assert_eq!(fmi2FreeFMUstate(c, &mut s), Status::Ok);
+        for &k in knowns {
+            let mut col = vec![0.0; unknowns.len()];
+            let st = fmi2GetDirectionalDerivative(c, unknowns.as_ptr(), unknowns.len(), &k, 1, &1.0, col.as_mut_ptr());
+            assert_eq!(st, Status::Ok, "{:?}", msgs(c));
+            out.extend(col);
+        }
+    }
+    free(c);
+    out
+}
+
+#[test]
+fn every_export_runs_on_a_host_thread_with_a_64_kib_stack() {
+    // The engine needs more than such a thread has (the bicycle's initialization alone
+    // overflowed 256 KiB before): the exports run it on a stack of their own. The result
+    // is the one of the test thread's 2 MiB stack, bit for bit.
+    for name in ["pendulum.xml", "benchmark_bicycle.xml", "cart_pendulum_pid.xml"] {
+        let text = model_text(name);
+        let (knowns, unknowns) = lin_refs(&text);
+        let want = full_run(&text, &knowns, &unknowns);
+        assert!(!want.is_empty());
+        let got = std::thread::Builder::new()
+            .stack_size(64 << 10)
+            .spawn(move || full_run(&text, &knowns, &unknowns))
+            .unwrap()
+            .join()
+            .unwrap();
+        assert_eq!(got, want, "{name}");
+    }
+}
+
+#[test]
+fn a_call_while_another_runs_on_the_instance_is_refused_not_let_in() {
+    // FMI allows one call at a time per instance. A call from a second thread, or from
+    // inside a running call (as a logger callback would make), gets fmi2Error and the
+    // instance stays intact, instead of a second &mut to it. The running call is held
+    // open with the guard the exports use, so the overlap is certain.
+    use mbfmu::fmi::guard::guarded;
+    use mbfmu::fmi::state_machine::Func;
+    use std::sync::mpsc::channel;
+    let text = model_text("pendulum.xml");
+    let c = initialized(&text, 1e-8, &[]);
+    let addr = c as usize;
+    let (inside, entered) = channel();
+    let (tried, answer) = channel();
+    let other = std::thread::spawn(move || {
+        entered.recv().unwrap();
+        let mut v = [0.0];
+        // SAFETY: a live instance (busy: the call must be refused), a one-element array.
+        let s = unsafe { fmi2GetReal(addr as Component, &0, 1, v.as_mut_ptr()) };
+        tried.send(s).unwrap();
+    });
+    let mut nested = None;
+    let held = guarded(c, Func::GetReal, |_| {
+        inside.send(()).unwrap();
+        let from_other_thread = answer.recv().unwrap();
+        let mut v = [0.0];
+        // SAFETY: as above, from the thread that holds the instance.
+        nested = Some((from_other_thread, unsafe { fmi2GetReal(c, &0, 1, v.as_mut_ptr()) }));
+        Ok(Status::Ok)
+    });
+    other.join().unwrap();
+    assert_eq!(held, Status::Ok);
+    assert_eq!(nested, Some((Status::Error, Status::Error)));
+    assert_eq!(get(c, &PENDULUM_OUTPUTS).len(), 5, "the instance goes on");
+    assert_eq!(step(c, 0.0, 0.1, 1), 0.1);
+    free(c);
+}
+
+#[test]
+fn a_serialized_state_with_any_byte_changed_or_cut_is_refused() {
+    let text = model_text("pendulum.xml");
+    let c = initialized(&text, 1e-8, &[]);
+    step(c, 0.0, 0.1, 2);
+    // SAFETY: a live instance and buffers of the stated sizes throughout.
+    unsafe {
+        let mut s = std::ptr::null_mut();
+        assert_eq!(fmi2GetFMUstate(c, &mut s), Status::Ok);
+        let mut n = 0usize;
+        assert_eq!(fmi2SerializedFMUstateSize(c, s, &mut n), Status::Ok);
+        let mut bytes = vec![0i8; n];
+        assert_eq!(fmi2SerializeFMUstate(c, s, bytes.as_mut_ptr(), n), Status::Ok);
+        assert_eq!(fmi2FreeFMUstate(c, &mut s), Status::Ok);
+        let mut back = std::ptr::null_mut();
+        for i in 0..n {
+            for bit in [0, 7] {
+                let mut b = bytes.clone();
+                b[i] ^= 1 << bit;
+                assert_eq!(fmi2DeSerializeFMUstate(c, b.as_ptr(), n, &mut back), Status::Error, "byte {i} bit {bit}");
+                assert!(back.is_null());
+            }
+        }
+        assert!(last_msg(c).contains("corrupted") || last_msg(c).contains("not a serialized state"));
+        for len in [0, 8, n / 2, n - 1] {
+            assert_eq!(fmi2DeSerializeFMUstate(c, bytes.as_ptr(), len, &mut back), Status::Error, "length {len}");
+        }
+        assert_eq!(fmi2DeSerializeFMUstate(c, bytes.as_ptr(), n, &mut back), Status::Ok, "the bytes as written");
+        assert_eq!(fmi2SetFMUstate(c, back), Status::Ok);
+        assert_eq!(fmi2FreeFMUstate(c, &mut back), Status::Ok);
+    }
+    free(c);
+}

@@ -30,6 +30,10 @@ from fmpy.fmi2 import (
 
 from .errors import ArgumentError, FMUCallError, FMUNotFoundError, MbfmuError
 
+# The step bound of mbfmu FMUs, and the budget this package gives one step to a time.
+MAX_STEPS_VARIABLE = "solver.maxSteps"
+BATCH_MAX_STEPS = 1_000_000
+
 # --- log capture --------------------------------------------------------------------
 # fmpy's native proxy (fmpy.logging.addLoggerProxy) formats the variadic message and calls
 # one Python function; that function is process-wide, so one dispatcher routes messages
@@ -261,6 +265,11 @@ class Instance:
         check_start_values(self.md, sv)
         fmu = self.fmu
         cs = self.interface == "CoSimulation"
+        if cs and MAX_STEPS_VARIABLE not in sv and any(v.name == MAX_STEPS_VARIABLE for v in self.md.modelVariables):
+            # An mbfmu FMU bounds one fmi2DoStep (solver.maxSteps, default 10 000); this
+            # package goes to each time asked in one step, so it gives that step the budget
+            # its Model Exchange path gives CVode (and `mbfmu linearize` its engine).
+            sv[MAX_STEPS_VARIABLE] = BATCH_MAX_STEPS
         self.time = start_time
         self.start_time = start_time
         if cs:

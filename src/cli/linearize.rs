@@ -9,7 +9,7 @@ use clap::Args;
 
 use super::CliError;
 use super::input_csv::InputTable;
-use crate::dae::{DEFAULT_MAX_STEPS, SimOptions, Simulator};
+use crate::dae::{BATCH_MAX_STEPS, SimOptions, Simulator};
 use crate::linearize::eigen::{eigen_table, format_table};
 use crate::linearize::{Linearization, Selection, linearize, select_states, state_values};
 use crate::model::parse::load_file;
@@ -32,8 +32,8 @@ pub struct LinearizeArgs {
     #[arg(long)]
     pub tol: Option<f64>,
     /// Most integrator step attempts on the way to each time (and between input rows);
-    /// more is an error at the time reached (as the FMU's solver.maxSteps).
-    #[arg(long, value_name = "N", default_value_t = DEFAULT_MAX_STEPS, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..))]
+    /// more is an error at the time reached (the FMU's solver.maxSteps bounds one step).
+    #[arg(long, value_name = "N", default_value_t = BATCH_MAX_STEPS, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..))]
     pub max_steps: usize,
     /// Find static equilibrium first (as `<analysis static="true"/>`).
     #[arg(long = "static")]

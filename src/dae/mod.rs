@@ -10,5 +10,5 @@ pub mod rank;
 mod simulator;
 pub mod sparse;
 
-pub use radau::DEFAULT_MAX_STEPS;
+pub use radau::{BATCH_MAX_STEPS, DEFAULT_MAX_STEPS};
 pub use simulator::{BodyState, EngineError, SimOptions, SimState, Simulator};

@@ -82,6 +82,11 @@ pub struct Radau {
 /// ends within about 10 s.
 pub const DEFAULT_MAX_STEPS: usize = 10_000;
 
+/// Step attempts per [`Radau::advance`] call for batch runs that go to a time in one call
+/// (`mbfmu linearize`, the Python package): the budget of a long simulation, not of one
+/// communication step (as CVODE's `mxstep` the package gives fmpy's CVode).
+pub const BATCH_MAX_STEPS: usize = 1_000_000;
+
 const NIT: usize = 7;
 const SAFE: f64 = 0.9;
 const FACL: f64 = 5.0;

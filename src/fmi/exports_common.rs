@@ -7,10 +7,11 @@
 #![allow(clippy::missing_safety_doc)]
 #![allow(non_snake_case)]
 
-use super::guard::{guarded, slice, slice_mut, text};
+use super::guard::{get, guarded, slice, slice_mut, text, with_stack};
 use super::guid::guid;
+use super::handle::{create, destroy, enter};
 use super::instance::Instance;
-use super::logger::Logger;
+use super::logger::{Logger, Sink};
 use super::state_machine::{Func, State};
 use super::types::{
     Boolean, CO_SIMULATION, CallbackFunctions, Component, FmiString, Integer, MODEL_EXCHANGE, Real, Status, TRUE,
@@ -67,16 +68,23 @@ pub unsafe extern "C" fn fmi2Instantiate(
             return std::ptr::null_mut();
         }
         // SAFETY: non-NULL and pointing to the host's callback struct per FMI.
-        let callbacks = unsafe { *functions };
+        let Ok(callbacks) = (unsafe { get(functions, "functions") }) else {
+            return std::ptr::null_mut();
+        };
         // SAFETY: a NUL-terminated string or NULL per FMI.
         let name = unsafe { text(instanceName, "instanceName") };
-        let mut log = Logger::new(&callbacks, name.as_deref().unwrap_or("?"), loggingOn == TRUE);
-        // SAFETY: NUL-terminated strings or NULL per FMI.
-        let made = name.and_then(|name| unsafe { instantiate(&name, fmuType, fmuGUID, fmuResourceLocation) });
+        let sink = Sink::new(&callbacks, name.as_deref().unwrap_or("?"));
+        // Reading the model and naming its variables (an engine run) needs the engine's stack.
+        let made = with_stack(|| {
+            // SAFETY: NUL-terminated strings or NULL per FMI.
+            let (model, guid) =
+                name.and_then(|name| unsafe { instantiate(&name, fmuType, fmuGUID, fmuResourceLocation) })?;
+            Ok::<_, String>(Instance::new(model, guid, Logger::new(loggingOn == TRUE)))
+        });
         match made {
-            Ok((model, guid)) => Box::into_raw(Box::new(Instance::new(model, guid, log))).cast(),
+            Ok(inst) => create(inst, sink),
             Err(msg) => {
-                log.log(Status::Error, &format!("fmi2Instantiate: {msg}"));
+                sink.emit(Status::Error, &format!("fmi2Instantiate: {msg}"));
                 std::ptr::null_mut()
             }
         }
@@ -116,15 +124,14 @@ unsafe fn instantiate(
     Ok((model, own))
 }
 
-/// fmi2FreeInstance (2.1.5): release the instance (NULL: nothing).
+/// fmi2FreeInstance (2.1.5): release the instance and the FMU states it still holds
+/// (NULL, or not a live instance: nothing; busy with another call: refused and logged).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2FreeInstance(c: Component) {
-    if c.is_null() {
-        return;
-    }
     let _ = catch_unwind(AssertUnwindSafe(|| {
-        // SAFETY: `c` came from Box::into_raw in fmi2Instantiate and is freed once (FMI).
-        drop(unsafe { Box::from_raw(c.cast::<Instance>()) });
+        if let Err(refused) = with_stack(|| destroy(c)) {
+            refused.report(Func::FreeInstance.name());
+        }
     }));
 }
 
@@ -281,25 +288,22 @@ no_variables! {
     fmi2SetString, Func::SetString, *const FmiString;
 }
 
-/// The messages an instance logged recently (those that passed its log filter).
+/// The messages an instance logged recently (those that passed its log filter); empty
+/// for a component that is not a live instance or is busy.
 ///
 /// # Safety
-/// `c` is NULL or a live instance from fmi2Instantiate not used concurrently.
+/// None beyond the FMI contract: `c` is checked against the live instances.
 #[doc(hidden)]
 pub unsafe fn last_messages(c: Component) -> Vec<String> {
-    if c.is_null() {
-        return Vec::new();
-    }
-    // SAFETY: per this function's contract.
-    unsafe { &*c.cast::<Instance>() }.log.recent()
+    enter(c).map(|mut s| s.instance().log.recent()).unwrap_or_default()
 }
 
-/// The instance's state-machine state (tests, diagnostics).
+/// The instance's state-machine state (tests, diagnostics); None for a component that is
+/// not a live instance or is busy.
 ///
 /// # Safety
 /// As [`last_messages`].
 #[doc(hidden)]
 pub unsafe fn instance_state(c: Component) -> Option<State> {
-    // SAFETY: per this function's contract.
-    (!c.is_null()).then(|| unsafe { &*c.cast::<Instance>() }.state)
+    enter(c).ok().map(|mut s| s.instance().state)
 }

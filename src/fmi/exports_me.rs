@@ -5,23 +5,23 @@
 #![allow(clippy::missing_safety_doc)]
 #![allow(non_snake_case)]
 
-use super::instance::Instance;
+use super::handle::enter;
 use super::types::{Boolean, Component, Real, Status};
 use libc::{c_void, size_t};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
 /// Log that `name` is Model Exchange only; fmi2Error.
 fn unsupported(c: Component, name: &str) -> Status {
-    if !c.is_null() {
-        let _ = catch_unwind(AssertUnwindSafe(|| {
-            // SAFETY: a live instance from fmi2Instantiate, one thread at a time (FMI).
-            let inst = unsafe { &mut *c.cast::<Instance>() };
-            inst.log(
+    let _ = catch_unwind(AssertUnwindSafe(|| match enter(c) {
+        Ok(mut s) => {
+            s.instance().log(
                 Status::Error,
                 &format!("{name}: Model Exchange is not supported (this FMU is Co-Simulation only)"),
             );
-        }));
-    }
+            s.finish();
+        }
+        Err(refused) => refused.report(name),
+    }));
     Status::Error
 }
 

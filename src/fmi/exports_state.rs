@@ -1,45 +1,29 @@
 //! FMI 2.0 FMU state functions (2.1.8 Getting and Setting the Complete FMU State).
-//! An fmi2FMUstate is a `Box<FmuState>` raw pointer.
+//! An fmi2FMUstate is a handle of the instance's [`StateHandles`]: one it did not hand
+//! out, or one already freed, is refused with fmi2Error.
 //!
-//! Safety of every export: as in `exports_common`; an fmi2FMUstate passed in must be one
-//! this FMU returned and has not freed.
+//! Safety of every export: as in `exports_common`.
 #![allow(clippy::missing_safety_doc)]
 #![allow(non_snake_case)]
 
 use super::fmu_state::FmuState;
-use super::guard::{guarded, put, slice, slice_mut};
+use super::guard::{get, guarded, put, slice, slice_mut};
+use super::state_handles::StateHandles;
 use super::state_machine::Func;
 use super::types::{Byte, Component, FmuStatePtr, Status};
 use libc::size_t;
 
-/// The state behind `p`.
+/// Store `s` through the host's `out` (`*out` NULL: a new state; else the live state
+/// there is overwritten, as FMI specifies).
 ///
 /// # Safety
-/// `p` is NULL or an fmi2FMUstate of this FMU not yet freed.
-unsafe fn state_ref<'a>(p: FmuStatePtr) -> Result<&'a FmuState, String> {
+/// `out` is NULL or valid for reads and writes of one fmi2FMUstate.
+unsafe fn store(handles: &mut StateHandles, out: *mut FmuStatePtr, s: FmuState) -> Result<(), String> {
     // SAFETY: per this function's contract.
-    unsafe { p.cast::<FmuState>().as_ref() }.ok_or_else(|| "FMUstate is NULL".into())
-}
-
-/// Store `s` in `*out`: reuse the state there (FMI: a non-NULL `*FMUstate` is one
-/// returned before), else allocate.
-///
-/// # Safety
-/// `out` is NULL or writable; `*out` is NULL or an fmi2FMUstate of this FMU not yet freed.
-unsafe fn store(out: *mut FmuStatePtr, s: FmuState) -> Result<(), String> {
-    if out.is_null() {
-        return Err("FMUstate is NULL".into());
-    }
+    let old = unsafe { get(out, "FMUstate") }?;
+    let p = handles.store(old, s)?;
     // SAFETY: per this function's contract.
-    unsafe {
-        let old = (*out).cast::<FmuState>();
-        if old.is_null() {
-            *out = Box::into_raw(Box::new(s)).cast();
-        } else {
-            *old = s;
-        }
-    }
-    Ok(())
+    unsafe { put(out, p, "FMUstate") }
 }
 
 /// fmi2GetFMUstate: a copy of the complete state.
@@ -47,17 +31,20 @@ unsafe fn store(out: *mut FmuStatePtr, s: FmuState) -> Result<(), String> {
 pub unsafe extern "C" fn fmi2GetFMUstate(c: Component, FMUstate: *mut FmuStatePtr) -> Status {
     guarded(c, Func::GetFmuState, |inst| {
         // SAFETY: per the module's contract.
-        unsafe { store(FMUstate, FmuState::capture(inst)) }?;
+        let s = FmuState::capture(inst);
+        // SAFETY: per the module's contract.
+        unsafe { store(&mut inst.states, FMUstate, s) }?;
         Ok(Status::Ok)
     })
 }
 
-/// fmi2SetFMUstate: continue from a saved state (also one of another instance of this FMU).
+/// fmi2SetFMUstate: continue from a state this instance saved (another instance's state
+/// arrives through fmi2SerializeFMUstate / fmi2DeSerializeFMUstate).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2SetFMUstate(c: Component, FMUstate: FmuStatePtr) -> Status {
     guarded(c, Func::SetFmuState, |inst| {
-        // SAFETY: per the module's contract.
-        unsafe { state_ref(FMUstate) }?.restore(inst)?;
+        let s = inst.states.get(FMUstate)?.clone();
+        s.restore(inst)?;
         Ok(Status::Ok)
     })
 }
@@ -65,18 +52,11 @@ pub unsafe extern "C" fn fmi2SetFMUstate(c: Component, FMUstate: FmuStatePtr) ->
 /// fmi2FreeFMUstate: release a state; `*FMUstate` becomes NULL.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2FreeFMUstate(c: Component, FMUstate: *mut FmuStatePtr) -> Status {
-    guarded(c, Func::FreeFmuState, |_| {
-        if FMUstate.is_null() {
-            return Err("FMUstate is NULL".into());
-        }
-        // SAFETY: per the module's contract; the Box came from `store` and is freed once.
-        unsafe {
-            let p = (*FMUstate).cast::<FmuState>();
-            if !p.is_null() {
-                drop(Box::from_raw(p));
-            }
-            *FMUstate = std::ptr::null_mut();
-        }
+    guarded(c, Func::FreeFmuState, |inst| {
+        // SAFETY: per the module's contract.
+        inst.states.free(unsafe { get(FMUstate, "FMUstate") }?)?;
+        // SAFETY: per the module's contract.
+        unsafe { put(FMUstate, std::ptr::null_mut(), "FMUstate") }?;
         Ok(Status::Ok)
     })
 }
@@ -84,9 +64,8 @@ pub unsafe extern "C" fn fmi2FreeFMUstate(c: Component, FMUstate: *mut FmuStateP
 /// fmi2SerializedFMUstateSize: bytes fmi2SerializeFMUstate writes.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2SerializedFMUstateSize(c: Component, FMUstate: FmuStatePtr, size: *mut size_t) -> Status {
-    guarded(c, Func::SerializedFmuStateSize, |_| {
-        // SAFETY: per the module's contract.
-        let n = unsafe { state_ref(FMUstate) }?.to_bytes().len();
+    guarded(c, Func::SerializedFmuStateSize, |inst| {
+        let n = inst.states.get(FMUstate)?.to_bytes().len();
         // SAFETY: a writable size_t per FMI.
         unsafe { put(size, n, "size") }?;
         Ok(Status::Ok)
@@ -101,9 +80,8 @@ pub unsafe extern "C" fn fmi2SerializeFMUstate(
     serializedState: *mut Byte,
     size: size_t,
 ) -> Status {
-    guarded(c, Func::SerializeFmuState, |_| {
-        // SAFETY: per the module's contract.
-        let bytes = unsafe { state_ref(FMUstate) }?.to_bytes();
+    guarded(c, Func::SerializeFmuState, |inst| {
+        let bytes = inst.states.get(FMUstate)?.to_bytes();
         if size < bytes.len() {
             return Err(format!("size {size} is less than the {} bytes of the state", bytes.len()));
         }
@@ -130,7 +108,7 @@ pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
             return Err(format!("the state belongs to FMU {}, not to this FMU {}", s.guid, inst.guid));
         }
         // SAFETY: per the module's contract.
-        unsafe { store(FMUstate, s) }?;
+        unsafe { store(&mut inst.states, FMUstate, s) }?;
         Ok(Status::Ok)
     })
 }

@@ -1,6 +1,7 @@
 //! Saved FMU states (2.1.8 Getting and Setting the Complete FMU State): the instance's
 //! state-machine state, the host's values and the engine state, and their byte form.
 
+use super::guid::checksum;
 use super::instance::{Config, Instance};
 use super::state_machine::State;
 use crate::dae::SimState;
@@ -84,13 +85,22 @@ impl FmuState {
             }
             None => w.0.push(0),
         }
+        let sum = checksum(&w.0);
+        w.0.extend_from_slice(&sum.to_le_bytes());
         w.0
     }
 
     /// fmi2DeSerializeFMUstate: what [`FmuState::to_bytes`] wrote.
     pub fn from_bytes(b: &[u8]) -> Result<FmuState, String> {
         let bad = || "not a serialized state of an mbfmu FMU (or truncated)".to_string();
-        let mut r = Reader { b: b.strip_prefix(MAGIC.as_slice()).ok_or_else(bad)?, pos: 0 };
+        let body = b.strip_prefix(MAGIC.as_slice()).ok_or_else(bad)?;
+        // The last 8 bytes: checksum of all before them; a changed byte is refused here
+        // rather than restored as a corrupted engine state.
+        let (body, sum) = body.split_at_checked(body.len().checked_sub(8).ok_or_else(bad)?).ok_or_else(bad)?;
+        if checksum(&b[..MAGIC.len() + body.len()]).to_le_bytes() != sum {
+            return Err("the serialized state is corrupted (checksum mismatch)".into());
+        }
+        let mut r = Reader { b: body, pos: 0 };
         let guid = String::from_utf8(r.bytes().ok_or_else(bad)?.to_vec()).map_err(|_| bad())?;
         let state = *State::ALL.get(r.byte().ok_or_else(bad)? as usize).ok_or_else(bad)?;
         let head = r.f64s().ok_or_else(bad)?;

@@ -1,34 +1,66 @@
-//! The wrapper every export runs in: NULL-instance check, the state-machine guard, panic
-//! containment (a Rust panic must never unwind into the host), and the logging of errors.
-//! Also the checked conversions of the host's array and string arguments.
+//! The wrapper every export runs in: the handle check (NULL, foreign, freed or busy
+//! components are refused), the state-machine guard, panic containment (a Rust panic must
+//! never unwind into the host), a stack of known size for the engine, and the logging of
+//! errors. Also the checked conversions of the host's array and string arguments.
 
+use super::handle::enter;
 use super::instance::Instance;
 use super::state_machine::{Func, State, check};
 use super::types::{Component, Status};
 use std::ffi::{CStr, c_char};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
+/// Stack the engine may use below the host's stack pointer. Measured on 2026-12-02: the
+/// full lifecycle of every example model (instantiation, initialization, steps, every
+/// directional derivative, FMU state round trip) run directly on a host thread needed a
+/// thread stack of 384 KiB (benchmark bicycle, four-bar, slider crank, cart with PID; the
+/// host's own frames included) and 192 KiB for the smallest. With less than this left
+/// (small host threads: musl's 128 KiB default, worker pools) the work runs on a stack of
+/// [`ENGINE_STACK`] instead.
+pub const RED_ZONE: usize = 2 << 20;
+
+/// Size of the stack the work runs on when the host's has less than [`RED_ZONE`] left.
+/// Memory is committed only as the stack is touched.
+pub const ENGINE_STACK: usize = 16 << 20;
+
+/// Run `f` with at least [`RED_ZONE`] bytes of stack (on a stack of its own if the
+/// caller's has less left).
+pub fn with_stack<R>(f: impl FnOnce() -> R) -> R {
+    stacker::maybe_grow(RED_ZONE, ENGINE_STACK, f)
+}
+
+/// The text of a panic payload.
+pub fn panic_text(payload: &(dyn std::any::Any + Send)) -> String {
+    payload
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "unknown panic".into())
+}
+
 /// Run `body` on the instance `c` if `func` is legal in its state. `Err(msg)` becomes
 /// fmi2Error with "fmi2X: msg" logged (category logStatusError); a state change is logged
 /// under logEvents; a panic becomes fmi2Error and state Error, or
 /// fmi2Fatal and state Fatal when the function may have left the engine half-updated.
-/// A NULL `c` gives fmi2Error (there is no logger to tell).
+/// A component that is not a live instance gives fmi2Error (there is no logger to tell);
+/// one busy with another call (the host's logger calling back, a second thread) gives
+/// fmi2Error and a message. The messages reach the host's logger after `body` is done.
 pub fn guarded(c: Component, func: Func, body: impl FnOnce(&mut Instance) -> Result<Status, String>) -> Status {
-    if c.is_null() {
-        return Status::Error;
-    }
-    let inst = c.cast::<Instance>();
+    let mut session = match enter(c) {
+        Ok(s) => s,
+        Err(refused) => {
+            refused.report(func.name());
+            return Status::Error;
+        }
+    };
+    let inst = session.instance();
     let run = catch_unwind(AssertUnwindSafe(|| {
-        // SAFETY: `c` is non-NULL and, as FMI 2.0 requires of the host, a pointer that
-        // fmi2Instantiate returned and fmi2FreeInstance has not freed; the host calls an
-        // instance from one thread at a time, so this is the only reference.
-        let inst = unsafe { &mut *inst };
         if let Err(msg) = check(inst.state, func) {
             inst.log(Status::Error, &msg);
             return Status::Error;
         }
         let before = inst.state;
-        let status = body(inst).unwrap_or_else(|msg| {
+        let status = with_stack(|| body(inst)).unwrap_or_else(|msg| {
             inst.log(Status::Error, &format!("{}: {msg}", func.name()));
             Status::Error
         });
@@ -37,22 +69,19 @@ pub fn guarded(c: Component, func: Func, body: impl FnOnce(&mut Instance) -> Res
         }
         status
     }));
-    run.unwrap_or_else(|payload| {
-        let what = payload
-            .downcast_ref::<&str>()
-            .map(|s| s.to_string())
-            .or_else(|| payload.downcast_ref::<String>().cloned())
-            .unwrap_or_else(|| "unknown panic".into());
+    let status = run.unwrap_or_else(|payload| {
+        let what = panic_text(payload.as_ref());
         let (status, state) =
             if func.rule().panic_is_fatal { (Status::Fatal, State::Fatal) } else { (Status::Error, State::Error) };
         let _ = catch_unwind(AssertUnwindSafe(|| {
-            // SAFETY: as above; the reference of the panicked closure is gone.
-            let inst = unsafe { &mut *inst };
+            let inst = session.instance();
             inst.state = state;
             inst.log(status, &format!("{}: internal error (panic): {what}", func.name()));
         }));
         status
-    })
+    });
+    session.finish();
+    status
 }
 
 /// The host's array `p` of `n` elements (empty when n = 0, whatever `p` is).
@@ -63,10 +92,8 @@ pub unsafe fn slice<'a, T>(p: *const T, n: usize, what: &str) -> Result<&'a [T],
     if n == 0 {
         return Ok(&[]);
     }
-    if p.is_null() {
-        return Err(format!("{what} is NULL"));
-    }
-    // SAFETY: non-NULL, and the caller guarantees n elements.
+    check_array(p, n, what)?;
+    // SAFETY: non-NULL, aligned, of a valid size, and the caller guarantees n elements.
     Ok(unsafe { std::slice::from_raw_parts(p, n) })
 }
 
@@ -79,11 +106,25 @@ pub unsafe fn slice_mut<'a, T>(p: *mut T, n: usize, what: &str) -> Result<&'a mu
     if n == 0 {
         return Ok(&mut []);
     }
+    check_array(p.cast_const(), n, what)?;
+    // SAFETY: non-NULL, aligned, of a valid size, and the caller guarantees n exclusive
+    // elements.
+    Ok(unsafe { std::slice::from_raw_parts_mut(p, n) })
+}
+
+/// What can be checked of an array argument of `n` > 0 elements: not NULL, aligned for
+/// `T`, and no larger than a Rust slice may be.
+fn check_array<T>(p: *const T, n: usize, what: &str) -> Result<(), String> {
     if p.is_null() {
         return Err(format!("{what} is NULL"));
     }
-    // SAFETY: non-NULL, and the caller guarantees n exclusive elements.
-    Ok(unsafe { std::slice::from_raw_parts_mut(p, n) })
+    if !p.is_aligned() {
+        return Err(format!("{what} ({p:p}) is not aligned for its element type"));
+    }
+    if n.checked_mul(size_of::<T>().max(1)).is_none_or(|b| b > isize::MAX as usize) {
+        return Err(format!("{what}: {n} elements is more than an array can hold"));
+    }
+    Ok(())
 }
 
 /// The host's string `p` (UTF-8 expected).
@@ -99,15 +140,23 @@ pub unsafe fn text(p: *const c_char, what: &str) -> Result<String, String> {
     s.to_str().map(str::to_string).map_err(|_| format!("{what} is not UTF-8"))
 }
 
+/// Read the value behind the host's pointer `p`.
+///
+/// # Safety
+/// If not NULL, `p` must be valid for a read of `T`.
+pub unsafe fn get<T: Copy>(p: *const T, what: &str) -> Result<T, String> {
+    check_array(p, 1, what)?;
+    // SAFETY: non-NULL, aligned and readable per the caller.
+    Ok(unsafe { p.read() })
+}
+
 /// Write `v` through the host's out-pointer `p`.
 ///
 /// # Safety
 /// If not NULL, `p` must be valid for a write of `T`.
 pub unsafe fn put<T>(p: *mut T, v: T, what: &str) -> Result<(), String> {
-    if p.is_null() {
-        return Err(format!("{what} is NULL"));
-    }
-    // SAFETY: non-NULL and writable per the caller.
+    check_array(p.cast_const(), 1, what)?;
+    // SAFETY: non-NULL, aligned and writable per the caller.
     unsafe { p.write(v) };
     Ok(())
 }

@@ -19,6 +19,11 @@ fn fnv1a128(parts: &[&[u8]]) -> u128 {
     h
 }
 
+/// A 64-bit checksum of `bytes` (FNV-1a), against corrupted serialized states.
+pub fn checksum(bytes: &[u8]) -> u64 {
+    fnv1a128(&[bytes]) as u64
+}
+
 /// The GUID of the FMU of `model_text`: `{8-4-4-4-12}` hex digits.
 pub fn guid(model_text: &str) -> String {
     let h = fnv1a128(&[ENGINE_VERSION.as_bytes(), model_text.as_bytes()]);

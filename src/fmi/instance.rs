@@ -3,6 +3,7 @@
 //! exports only translate pointers and statuses.
 
 use super::logger::Logger;
+use super::state_handles::StateHandles;
 use super::state_machine::State;
 use super::types::Status;
 use super::variables::{Target, Variable, variables};
@@ -56,6 +57,8 @@ pub struct Instance {
     pub dirty: bool,
     /// fmi2LastSuccessfulTime.
     pub last_time: f64,
+    /// The FMU states handed to the host and not yet freed.
+    pub states: StateHandles,
 }
 
 impl Instance {
@@ -64,7 +67,18 @@ impl Instance {
         let vars = variables(&base);
         let config = Self::default_config(&base);
         let last_time = config.start;
-        Instance { log, state: State::Instantiated, guid, base, vars, config, built: None, dirty: true, last_time }
+        Instance {
+            log,
+            state: State::Instantiated,
+            guid,
+            base,
+            vars,
+            config,
+            built: None,
+            dirty: true,
+            last_time,
+            states: StateHandles::default(),
+        }
     }
 
     fn default_config(m: &Model) -> Config {
@@ -269,7 +283,22 @@ impl Instance {
                 Target::MaxSteps => unreachable!("refused above: an Integer variable"),
             };
         }
-        Ok(())
+        self.all_finite("fmi2GetReal", vrs, out)
+    }
+
+    /// Err naming the first value of `out` (for `vrs`) that is not finite: a host must
+    /// never read NaN or an infinity with fmi2OK (the motion or the parameters overflowed).
+    fn all_finite(&self, what: &str, vrs: &[u32], out: &[f64]) -> Result<(), String> {
+        match vrs.iter().zip(out).find(|(_, v)| !v.is_finite()) {
+            None => Ok(()),
+            Some((&vr, v)) => {
+                let name = self.var(vr).map(|x| x.name.as_str()).unwrap_or("?");
+                Err(format!(
+                    "{what} of '{name}' (vr {vr}) is {v} at t = {}: the motion or the values set overflow",
+                    self.last_time
+                ))
+            }
+        }
     }
 
     /// Whether the engine runs (initialization has ended).
@@ -400,7 +429,7 @@ impl Instance {
             }
             *o = acc;
         }
-        Ok(())
+        self.all_finite("the directional derivative", unknowns, out)
     }
 
     /// fmi2SetRealInputDerivatives (order 1 only: inputs change linearly over a step).
@@ -495,7 +524,7 @@ impl Instance {
         for (o, k) in out.iter_mut().zip(ks) {
             *o = d[k];
         }
-        Ok(())
+        self.all_finite("the derivative", vrs, out)
     }
 
     /// Log a message through the host's logger.

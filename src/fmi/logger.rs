@@ -1,6 +1,9 @@
 //! Logging through the host's fmi2CallbackLogger (2.1.5), filtered by the categories of
-//! fmi2SetDebugLogging. The text is always passed as the argument of a `"%s"` format, so
-//! a `%` in a message (a path, a user name) is never read as a conversion.
+//! fmi2SetDebugLogging. An instance only queues its messages ([`Logger`]); the handle
+//! hands them to the host ([`Sink`]) after the call's work is done, when no reference
+//! into the instance is alive, so a logger that calls back into the FMU cannot alias it.
+//! The text is always passed as the argument of a `"%s"` format, so a `%` in a message
+//! (a path, a user name) is never read as a conversion.
 
 use super::types::{CallbackFunctions, ComponentEnvironment, LoggerFn, Status};
 use std::collections::VecDeque;
@@ -30,29 +33,21 @@ fn category(status: Status) -> &'static CStr {
     }
 }
 
-/// One instance's logger.
+/// One instance's log filter and the messages waiting for the host.
+#[derive(Default)]
 pub struct Logger {
-    callback: Option<LoggerFn>,
-    env: ComponentEnvironment,
-    name: CString,
     /// loggingOn of fmi2Instantiate / fmi2SetDebugLogging.
     on: bool,
     /// Enabled categories (None: all).
     enabled: Option<Vec<&'static CStr>>,
     recent: VecDeque<String>,
+    pending: Vec<(Status, String)>,
 }
 
 impl Logger {
-    /// A logger for instance `name` with the host's callbacks.
-    pub fn new(callbacks: &CallbackFunctions, name: &str, on: bool) -> Logger {
-        Logger {
-            callback: callbacks.logger,
-            env: callbacks.component_environment,
-            name: c_text(name),
-            on,
-            enabled: None,
-            recent: VecDeque::new(),
-        }
+    /// A logger with logging `on` (loggingOn of fmi2Instantiate) and every category.
+    pub fn new(on: bool) -> Logger {
+        Logger { on, ..Logger::default() }
     }
 
     /// fmi2SetDebugLogging: switch logging and choose categories (none listed: all).
@@ -67,11 +62,12 @@ impl Logger {
         Ok(())
     }
 
-    /// Whether a message with `status` reaches the host. With logging off only errors
-    /// (fmi2Error, fmi2Fatal) do: the host must learn why a call failed.
+    /// Whether a message with `status` reaches the host. With logging off only those of
+    /// failed calls (fmi2Discard, fmi2Error, fmi2Fatal) do: the host must learn why a call
+    /// or a step failed.
     fn passes(&self, status: Status) -> bool {
         if !self.on {
-            return status >= Status::Error;
+            return matches!(status, Status::Discard | Status::Error | Status::Fatal);
         }
         match &self.enabled {
             None => true,
@@ -79,7 +75,8 @@ impl Logger {
         }
     }
 
-    /// Log `msg` with `status` (its category follows from the status).
+    /// Log `msg` with `status` (its category follows from the status): queued for the
+    /// host if it passes the filter.
     pub fn log(&mut self, status: Status, msg: &str) {
         if !self.passes(status) {
             return;
@@ -88,6 +85,36 @@ impl Logger {
             self.recent.pop_front();
         }
         self.recent.push_back(msg.to_string());
+        self.pending.push((status, msg.to_string()));
+    }
+
+    /// The queued messages, oldest first (the queue is left empty).
+    pub fn take_pending(&mut self) -> Vec<(Status, String)> {
+        std::mem::take(&mut self.pending)
+    }
+
+    /// The most recent messages that passed the filter, oldest first.
+    pub fn recent(&self) -> Vec<String> {
+        self.recent.iter().cloned().collect()
+    }
+}
+
+/// The host's logger callback, its environment and the instance name.
+#[derive(Clone)]
+pub struct Sink {
+    callback: Option<LoggerFn>,
+    env: ComponentEnvironment,
+    name: CString,
+}
+
+impl Sink {
+    /// The sink of instance `name` with the host's callbacks.
+    pub fn new(callbacks: &CallbackFunctions, name: &str) -> Sink {
+        Sink { callback: callbacks.logger, env: callbacks.component_environment, name: c_text(name) }
+    }
+
+    /// Hand `msg` to the host's logger (nothing when it gave none).
+    pub fn emit(&self, status: Status, msg: &str) {
         if let Some(cb) = self.callback {
             let text = c_text(msg);
             // SAFETY: `cb` is the host's fmi2CallbackLogger; every pointer passed is a valid
@@ -105,11 +132,6 @@ impl Logger {
             };
         }
     }
-
-    /// The most recent messages that passed the filter, oldest first.
-    pub fn recent(&self) -> Vec<String> {
-        self.recent.iter().cloned().collect()
-    }
 }
 
 /// A C string of `s` (an interior NUL becomes a space).
@@ -121,27 +143,24 @@ fn c_text(s: &str) -> CString {
 mod tests {
     use super::*;
 
-    fn logger(on: bool) -> Logger {
-        let cb = CallbackFunctions {
-            logger: None,
-            allocate_memory: None,
-            free_memory: None,
-            step_finished: None,
-            component_environment: std::ptr::null_mut(),
-        };
-        Logger::new(&cb, "inst", on)
-    }
-
     #[test]
     fn categories_filter_what_reaches_the_host() {
-        let mut l = logger(false);
+        let mut l = Logger::new(false);
         l.log(Status::Ok, "event");
+        l.log(Status::Warning, "warning");
+        l.log(Status::Discard, "step stopped");
         l.log(Status::Error, "error");
-        assert_eq!(l.recent(), ["error"]);
+        assert_eq!(l.recent(), ["step stopped", "error"], "logging off: failed calls only");
         l.configure(true, &["logStatusDiscard".into()]).unwrap();
         l.log(Status::Ok, "event");
         l.log(Status::Discard, "discard");
-        assert_eq!(l.recent(), ["error", "discard"]);
+        assert_eq!(l.recent(), ["step stopped", "error", "discard"]);
+        let pending = l.take_pending();
+        assert_eq!(
+            pending.iter().map(|(s, _)| *s).collect::<Vec<_>>(),
+            [Status::Discard, Status::Error, Status::Discard]
+        );
+        assert!(l.take_pending().is_empty());
         assert!(l.configure(true, &["nonsense".into()]).is_err());
     }
 }

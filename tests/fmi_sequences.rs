@@ -1,0 +1,500 @@
+//! FMI call-sequence fuzzing (issue 12 item 5): random legal and illegal call orders over
+//! every example model, with bad value references, NaN/Inf/huge values, zero, negative
+//! and huge steps, stale and foreign FMU-state handles, corrupted serialized states, NULL
+//! arrays, directional derivatives of random subsets, freed components. What must hold:
+//! the process survives (a crash ends the test run), no call panics inside (the guard
+//! would answer it, and logs "internal error (panic)"), every call returns, within a
+//! bound, and no call answering fmi2OK hands out a value that is not finite.
+//!
+//! `MBFMU_FMI_SEQUENCES` (default 300, what CI runs) sets how many sequences;
+//! `MBFMU_FMI_SEED` the base seed; `bench/fmi_sequences.sh` runs thousands.
+
+use mbfmu::fmi::exports_common::*;
+use mbfmu::fmi::exports_cs::*;
+use mbfmu::fmi::exports_me::*;
+use mbfmu::fmi::exports_state::*;
+use mbfmu::fmi::guid::guid;
+use mbfmu::fmi::types::{
+    CO_SIMULATION, CallbackFunctions, Component, DO_STEP_STATUS, FmuStatePtr, LAST_SUCCESSFUL_TIME, Status, TERMINATED,
+};
+use mbfmu::fmi::variables::{Causality, variables};
+use std::collections::BTreeMap;
+use std::ffi::CString;
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+/// The longest any single call may take. A doStep is bounded by `solver.maxSteps`; the
+/// sequences set it to at most [`MAX_STEPS`] (or leave the default), so on these models a
+/// call takes well under a second; 60 s means "does not come back".
+const CALL_LIMIT: Duration = Duration::from_secs(60);
+const MAX_STEPS: i32 = 3000;
+
+/// splitmix64: a small, well-mixed generator, so a seed names a sequence exactly.
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+    fn below(&mut self, n: usize) -> usize {
+        (self.next() % n as u64) as usize
+    }
+    fn chance(&mut self, p: f64) -> bool {
+        (self.next() >> 11) as f64 / (1u64 << 53) as f64 <= p
+    }
+    fn pick<T: Copy>(&mut self, v: &[T]) -> T {
+        v[self.below(v.len())]
+    }
+    /// A value: mostly ordinary, sometimes hostile.
+    fn real(&mut self) -> f64 {
+        match self.below(12) {
+            0 => f64::NAN,
+            1 => f64::INFINITY,
+            2 => f64::NEG_INFINITY,
+            3 => self.pick(&[1e308, -1e308, 1e-310, 1e30, -1e30]),
+            4 => 0.0,
+            _ => (self.next() >> 11) as f64 / (1u64 << 53) as f64 * 4.0 - 2.0,
+        }
+    }
+}
+
+/// One model as the host sees it: its resource URI, GUID and value references.
+struct Model {
+    name: String,
+    uri: CString,
+    guid: CString,
+    reals: Vec<u32>,
+    parameters: Vec<u32>,
+    inputs: Vec<u32>,
+    outputs: Vec<u32>,
+    knowns: Vec<u32>,
+    unknowns: Vec<u32>,
+    /// `solver.maxSteps` (Integer), when the FMU has it.
+    max_steps: Option<u32>,
+}
+
+fn models() -> Vec<Model> {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let mut files: Vec<PathBuf> = std::fs::read_dir(root.join("models")).unwrap().map(|e| e.unwrap().path()).collect();
+    files.retain(|p| p.extension().is_some_and(|e| e == "xml"));
+    files.sort();
+    files
+        .iter()
+        .map(|path| {
+            let text = std::fs::read_to_string(path).unwrap();
+            let name = path.file_stem().unwrap().to_string_lossy().to_string();
+            let dir = std::env::temp_dir().join(format!("mbfmu-seq-{}-{name}", std::process::id())).join("resources");
+            std::fs::create_dir_all(&dir).unwrap();
+            std::fs::write(dir.join("model.xml"), &text).unwrap();
+            let m = mbfmu::model::parse::load_str(&text, "model.xml").unwrap();
+            let vars = variables(&m);
+            let vr = |f: &dyn Fn(&mbfmu::fmi::variables::Variable) -> bool| {
+                vars.iter().filter(|v| f(v)).map(|v| v.value_reference).collect::<Vec<u32>>()
+            };
+            let max_steps = vars.iter().find(|v| v.name == "solver.maxSteps").map(|v| v.value_reference);
+            Model {
+                uri: CString::new(format!("file://{}", dir.display())).unwrap(),
+                guid: CString::new(guid(&text)).unwrap(),
+                reals: vr(&|v| Some(v.value_reference) != max_steps),
+                parameters: vr(&|v| v.causality == Causality::Parameter && Some(v.value_reference) != max_steps),
+                inputs: vr(&|v| v.causality == Causality::Input),
+                outputs: vr(&|v| v.causality == Causality::Output),
+                knowns: vr(&|v| v.known.is_some() || v.causality == Causality::Input),
+                unknowns: vr(&|v| v.unknown.is_some() || v.causality == Causality::Output),
+                max_steps,
+                name,
+            }
+        })
+        .collect()
+}
+
+const CALLBACKS: CallbackFunctions = CallbackFunctions {
+    logger: None,
+    allocate_memory: None,
+    free_memory: None,
+    step_finished: None,
+    component_environment: std::ptr::null_mut(),
+};
+
+/// What the run saw.
+#[derive(Default)]
+struct Tally {
+    calls: usize,
+    by_status: BTreeMap<String, usize>,
+    /// Calls answered fmi2OK, by function.
+    ok_by_function: BTreeMap<String, usize>,
+    slowest: (Duration, String),
+    failures: Vec<String>,
+}
+
+impl Tally {
+    /// Time `f` (the call `what` on component `c`) and check its status and messages.
+    fn call(&mut self, c: Component, what: &str, f: impl FnOnce() -> Status) -> Status {
+        let t0 = Instant::now();
+        let s = f();
+        let dt = t0.elapsed();
+        self.calls += 1;
+        *self.by_status.entry(format!("{s:?}")).or_default() += 1;
+        if s == Status::Ok {
+            *self.ok_by_function.entry(what.to_string()).or_default() += 1;
+        }
+        if dt > self.slowest.0 {
+            self.slowest = (dt, what.to_string());
+        }
+        if dt > CALL_LIMIT {
+            self.failures.push(format!("{what} took {dt:?}"));
+        }
+        // SAFETY: last_messages checks the component against the live instances.
+        if let Some(m) = unsafe { last_messages(c) }.iter().find(|m| m.contains("internal error (panic)")) {
+            self.failures.push(format!("{what}: {m}"));
+        }
+        s
+    }
+
+    /// Values a call answered fmi2OK with must be finite.
+    fn finite(&mut self, what: &str, s: Status, v: &[f64]) {
+        if s == Status::Ok && v.iter().any(|x| !x.is_finite()) {
+            self.failures.push(format!("{what} returned fmi2OK with {v:?}"));
+        }
+    }
+}
+
+/// A random subset (with repeats and strangers) of `vrs`.
+fn refs(r: &mut Rng, vrs: &[u32], all: &[u32]) -> Vec<u32> {
+    let n = r.below(6);
+    (0..n)
+        .map(|_| match r.below(10) {
+            0 => r.pick(&[u32::MAX, 100_000, all.len() as u32]),
+            1 if !all.is_empty() => r.pick(all),
+            _ if !vrs.is_empty() => r.pick(vrs),
+            _ => r.next() as u32 % 64,
+        })
+        .collect()
+}
+
+/// The bytes of state `st` (`short`: into a buffer half the size it needs, which must be
+/// refused).
+fn serialize(tally: &mut Tally, c: Component, st: FmuStatePtr, short: bool) -> Vec<i8> {
+    let mut n = 0usize;
+    // SAFETY: a writable size; `c` live or refused.
+    if tally.call(c, "fmi2SerializedFMUstateSize", || unsafe { fmi2SerializedFMUstateSize(c, st, &mut n) })
+        != Status::Ok
+    {
+        return Vec::new();
+    }
+    let len = if short { n / 2 } else { n };
+    let mut bytes = vec![0; len];
+    // SAFETY: `len` writable bytes.
+    let s = tally.call(c, "fmi2SerializeFMUstate", || unsafe { fmi2SerializeFMUstate(c, st, bytes.as_mut_ptr(), len) });
+    if s == Status::Ok { bytes } else { Vec::new() }
+}
+
+/// One sequence on model `m`: instantiate (sometimes wrongly), then random calls.
+fn sequence(r: &mut Rng, m: &Model, other: &Model, tally: &mut Tally) {
+    let name = c"seq";
+    let bad_guid = CString::new("{00000000-0000-0000-0000-000000000000}").unwrap();
+    let guid = if r.chance(0.03) { &bad_guid } else { &m.guid };
+    let fmu_type = if r.chance(0.03) { r.pick(&[0, 7, -1]) } else { CO_SIMULATION };
+    // SAFETY: valid strings and callbacks (the wrong GUID and type are refused values).
+    let c = unsafe { fmi2Instantiate(name.as_ptr(), fmu_type, guid.as_ptr(), m.uri.as_ptr(), &CALLBACKS, 0, 1) };
+    if c.is_null() {
+        return;
+    }
+    // A second instance, of another model: its states are foreign handles here.
+    // SAFETY: as above.
+    let d = unsafe {
+        fmi2Instantiate(name.as_ptr(), CO_SIMULATION, other.guid.as_ptr(), other.uri.as_ptr(), &CALLBACKS, 0, 0)
+    };
+    let mut foreign: FmuStatePtr = std::ptr::null_mut();
+    if !d.is_null() {
+        // SAFETY: a live instance and a writable handle.
+        unsafe { fmi2GetFMUstate(d, &mut foreign) };
+    }
+    let mut states: Vec<FmuStatePtr> = Vec::new();
+    let mut freed: Vec<FmuStatePtr> = Vec::new();
+    let mut bytes: Vec<i8> = Vec::new();
+    let mut time = 0.0;
+    let mut alive = true;
+    if let Some(vr) = m.max_steps
+        && r.chance(0.9)
+    {
+        let n = r.pick(&[1, 10, 200, MAX_STEPS]);
+        // SAFETY: one element each.
+        tally.call(c, "fmi2SetInteger", || unsafe { fmi2SetInteger(c, &vr, 1, &n) });
+    }
+    // Mostly the legal opening, so that the random part reaches the stepping states.
+    if r.chance(0.85) {
+        let stop = r.chance(0.2);
+        // SAFETY: a live instance.
+        tally.call(c, "fmi2SetupExperiment", || unsafe { fmi2SetupExperiment(c, 1, 1e-6, 0.0, stop as i32, 5.0) });
+        // SAFETY: a live instance.
+        tally.call(c, "fmi2EnterInitializationMode", || unsafe { fmi2EnterInitializationMode(c) });
+        if r.chance(0.9) {
+            // SAFETY: a live instance.
+            tally.call(c, "fmi2ExitInitializationMode", || unsafe { fmi2ExitInitializationMode(c) });
+        }
+    }
+    let n_calls = 5 + r.below(40);
+    for _ in 0..n_calls {
+        // SAFETY (every call below): the arrays passed hold the counts passed, or are NULL
+        // with a count the FMU must refuse; `c` is a live or freed instance (a freed one
+        // must be refused, which is part of what is tested).
+        unsafe {
+            match r.below(30) {
+                0 => {
+                    let tol = if r.chance(0.7) { 1e-6 } else { r.real() };
+                    tally.call(c, "fmi2SetupExperiment", || fmi2SetupExperiment(c, 1, tol, r.real(), 0, 0.0));
+                }
+                1 => {
+                    tally.call(c, "fmi2EnterInitializationMode", || fmi2EnterInitializationMode(c));
+                }
+                2 => {
+                    tally.call(c, "fmi2ExitInitializationMode", || fmi2ExitInitializationMode(c));
+                }
+                3..=6 => {
+                    let h = if r.chance(0.7) { r.pick(&[0.01, 0.1, 0.5, 1.0]) } else { r.real() };
+                    let t = if r.chance(0.8) { time } else { r.real() };
+                    let s = tally.call(c, "fmi2DoStep", || fmi2DoStep(c, t, h, 0));
+                    let mut last = f64::NAN;
+                    let q =
+                        tally.call(c, "fmi2GetRealStatus", || fmi2GetRealStatus(c, LAST_SUCCESSFUL_TIME, &mut last));
+                    tally.finite("fmi2GetRealStatus", q, &[last]);
+                    if q == Status::Ok {
+                        time = last;
+                    }
+                    if s == Status::Discard && r.chance(0.5) && !states.is_empty() {
+                        let st = r.pick(&states);
+                        tally.call(c, "fmi2SetFMUstate", || fmi2SetFMUstate(c, st));
+                    }
+                }
+                7..=8 => {
+                    let vrs = refs(r, &m.reals, &m.reals);
+                    let mut v = vec![f64::NAN; vrs.len()];
+                    let s = tally.call(c, "fmi2GetReal", || fmi2GetReal(c, vrs.as_ptr(), vrs.len(), v.as_mut_ptr()));
+                    tally.finite("fmi2GetReal", s, &v);
+                }
+                9..=10 => {
+                    let pool = if r.chance(0.5) { &m.inputs } else { &m.parameters };
+                    let vrs = refs(r, pool, &m.reals);
+                    let v: Vec<f64> = vrs.iter().map(|_| r.real()).collect();
+                    tally.call(c, "fmi2SetReal", || fmi2SetReal(c, vrs.as_ptr(), vrs.len(), v.as_ptr()));
+                }
+                11 => {
+                    let vrs = refs(r, &m.inputs, &m.reals);
+                    let orders: Vec<i32> =
+                        vrs.iter().map(|_| if r.chance(0.8) { 1 } else { r.pick(&[0, 2, -1]) }).collect();
+                    let v: Vec<f64> = vrs.iter().map(|_| r.real() * r.pick(&[1.0, 1e6])).collect();
+                    tally.call(c, "fmi2SetRealInputDerivatives", || {
+                        fmi2SetRealInputDerivatives(c, vrs.as_ptr(), vrs.len(), orders.as_ptr(), v.as_ptr())
+                    });
+                }
+                12 => {
+                    let vrs = refs(r, &m.outputs, &m.reals);
+                    let orders = vec![1; vrs.len()];
+                    let mut v = vec![f64::NAN; vrs.len()];
+                    let s = tally.call(c, "fmi2GetRealOutputDerivatives", || {
+                        fmi2GetRealOutputDerivatives(c, vrs.as_ptr(), vrs.len(), orders.as_ptr(), v.as_mut_ptr())
+                    });
+                    tally.finite("fmi2GetRealOutputDerivatives", s, &v);
+                }
+                13..=15 => {
+                    let u = refs(r, &m.unknowns, &m.reals);
+                    let k = refs(r, &m.knowns, &m.reals);
+                    let seed: Vec<f64> = k.iter().map(|_| if r.chance(0.9) { 1.0 } else { r.real() }).collect();
+                    let mut v = vec![f64::NAN; u.len()];
+                    let s = tally.call(c, "fmi2GetDirectionalDerivative", || {
+                        fmi2GetDirectionalDerivative(
+                            c,
+                            u.as_ptr(),
+                            u.len(),
+                            k.as_ptr(),
+                            k.len(),
+                            seed.as_ptr(),
+                            v.as_mut_ptr(),
+                        )
+                    });
+                    tally.finite("fmi2GetDirectionalDerivative", s, &v);
+                }
+                16 => {
+                    let mut s: FmuStatePtr = std::ptr::null_mut();
+                    if tally.call(c, "fmi2GetFMUstate", || fmi2GetFMUstate(c, &mut s)) == Status::Ok {
+                        states.push(s);
+                    }
+                }
+                17 => {
+                    // A live, freed, foreign or made-up handle.
+                    let st = match r.below(4) {
+                        0 if !freed.is_empty() => r.pick(&freed),
+                        1 => foreign,
+                        2 => 0x1000 as FmuStatePtr,
+                        _ if !states.is_empty() => r.pick(&states),
+                        _ => std::ptr::null_mut(),
+                    };
+                    tally.call(c, "fmi2SetFMUstate", || fmi2SetFMUstate(c, st));
+                }
+                18 => {
+                    let mut st = match r.below(3) {
+                        0 if !freed.is_empty() => r.pick(&freed),
+                        1 => foreign,
+                        _ if !states.is_empty() => states.swap_remove(r.below(states.len())),
+                        _ => std::ptr::null_mut(),
+                    };
+                    let orig = st;
+                    if tally.call(c, "fmi2FreeFMUstate", || fmi2FreeFMUstate(c, &mut st)) == Status::Ok
+                        && !orig.is_null()
+                    {
+                        freed.push(orig);
+                    }
+                }
+                19 => {
+                    if let Some(&st) = states.last() {
+                        bytes = serialize(tally, c, st, r.chance(0.2));
+                    }
+                }
+                20 => {
+                    // Deserialize as written, corrupted, truncated, or noise.
+                    if bytes.is_empty()
+                        && let Some(&st) = states.last()
+                    {
+                        bytes = serialize(tally, c, st, false);
+                    }
+                    let mut b = bytes.clone();
+                    match r.below(6) {
+                        0 if !b.is_empty() => {
+                            for _ in 0..1 + r.below(4) {
+                                let i = r.below(b.len());
+                                b[i] ^= 1 << r.below(8);
+                            }
+                        }
+                        1 => b.truncate(r.below(b.len() + 1)),
+                        2 => b = (0..r.below(200)).map(|_| r.next() as i8).collect(),
+                        _ => {}
+                    }
+                    let mut st: FmuStatePtr = std::ptr::null_mut();
+                    if tally
+                        .call(c, "fmi2DeSerializeFMUstate", || fmi2DeSerializeFMUstate(c, b.as_ptr(), b.len(), &mut st))
+                        == Status::Ok
+                    {
+                        states.push(st);
+                    }
+                }
+                21 => {
+                    tally.call(c, "fmi2Reset", || fmi2Reset(c));
+                    time = 0.0;
+                }
+                22 => {
+                    tally.call(c, "fmi2Terminate", || fmi2Terminate(c));
+                }
+                23 => {
+                    let cats = [c"logEvents".as_ptr(), c"nonsense".as_ptr(), c"logAll".as_ptr()];
+                    let n = r.below(4);
+                    tally.call(c, "fmi2SetDebugLogging", || fmi2SetDebugLogging(c, 1, n, cats.as_ptr()));
+                }
+                24 => {
+                    let mut st = Status::Ok;
+                    let mut b = 0;
+                    let kind = r.pick(&[DO_STEP_STATUS, TERMINATED, 9]);
+                    tally.call(c, "fmi2GetStatus", || fmi2GetStatus(c, kind, &mut st));
+                    tally.call(c, "fmi2GetBooleanStatus", || fmi2GetBooleanStatus(c, kind, &mut b));
+                    tally.call(c, "fmi2CancelStep", || fmi2CancelStep(c));
+                }
+                25 => {
+                    // NULL arrays with non-zero counts.
+                    let n = 1 + r.below(3);
+                    tally.call(c, "fmi2GetReal", || fmi2GetReal(c, std::ptr::null(), n, std::ptr::null_mut()));
+                    tally.call(c, "fmi2SetReal", || {
+                        fmi2SetReal(c, m.reals.as_ptr(), n.min(m.reals.len()), std::ptr::null())
+                    });
+                    tally.call(c, "fmi2GetDirectionalDerivative", || {
+                        fmi2GetDirectionalDerivative(
+                            c,
+                            std::ptr::null(),
+                            n,
+                            std::ptr::null(),
+                            n,
+                            std::ptr::null(),
+                            std::ptr::null_mut(),
+                        )
+                    });
+                }
+                26 => {
+                    if let Some(vr) = m.max_steps {
+                        let n = if r.chance(0.7) { r.pick(&[1, 50, MAX_STEPS]) } else { r.pick(&[0, -5, i32::MIN]) };
+                        tally.call(c, "fmi2SetInteger", || fmi2SetInteger(c, &vr, 1, &n));
+                        let mut got = 0;
+                        tally.call(c, "fmi2GetInteger", || fmi2GetInteger(c, &vr, 1, &mut got));
+                    }
+                }
+                27 => {
+                    tally.call(c, "fmi2SetTime", || fmi2SetTime(c, r.real()));
+                }
+                28 if r.chance(0.3) => {
+                    // Free mid-sequence: every later call must be refused, not crash.
+                    fmi2FreeInstance(c);
+                    alive = false;
+                }
+                _ => {
+                    let vrs = refs(r, &m.outputs, &m.reals);
+                    let mut v = vec![f64::NAN; vrs.len()];
+                    let s = tally.call(c, "fmi2GetReal", || fmi2GetReal(c, vrs.as_ptr(), vrs.len(), v.as_mut_ptr()));
+                    tally.finite("fmi2GetReal", s, &v);
+                }
+            }
+        }
+        if !alive {
+            // SAFETY: the freed component is refused by every export.
+            let s = unsafe { fmi2Terminate(c) };
+            if s != Status::Error {
+                tally.failures.push(format!("{}: a freed instance answered {s:?}", m.name));
+            }
+            break;
+        }
+    }
+    // SAFETY: live instances (or already freed: refused); `foreign` belongs to `d`.
+    unsafe {
+        if alive {
+            fmi2FreeInstance(c);
+        }
+        if !d.is_null() {
+            fmi2FreeFMUstate(d, &mut foreign);
+            fmi2FreeInstance(d);
+        }
+    }
+}
+
+#[test]
+fn random_fmi_call_sequences_never_crash_hang_panic_or_return_nan_with_ok() {
+    let count: usize = std::env::var("MBFMU_FMI_SEQUENCES").ok().and_then(|v| v.parse().ok()).unwrap_or(300);
+    let seed: u64 = std::env::var("MBFMU_FMI_SEED").ok().and_then(|v| v.parse().ok()).unwrap_or(12);
+    let ms = models();
+    let mut tally = Tally::default();
+    let t0 = Instant::now();
+    for k in 0..count {
+        let mut r = Rng(seed.wrapping_mul(1_000_003).wrapping_add(k as u64));
+        let (a, b) = (r.below(ms.len()), r.below(ms.len()));
+        let before = tally.failures.len();
+        sequence(&mut r, &ms[a], &ms[b], &mut tally);
+        for f in &mut tally.failures[before..] {
+            *f = format!("sequence {k} (seed {seed}, model {}): {f}", ms[a].name);
+        }
+    }
+    println!(
+        "{count} sequences, {} calls in {:.1} s; statuses {:?}; slowest call {:?} ({})\nfmi2OK by function: {:?}",
+        tally.calls,
+        t0.elapsed().as_secs_f64(),
+        tally.by_status,
+        tally.slowest.0,
+        tally.slowest.1,
+        tally.ok_by_function
+    );
+    assert!(tally.failures.is_empty(), "{} failures:\n{}", tally.failures.len(), tally.failures.join("\n"));
+    // The sequences reach the interesting states: steps, derivatives and states succeed.
+    for f in ["fmi2DoStep", "fmi2GetDirectionalDerivative", "fmi2SetFMUstate", "fmi2DeSerializeFMUstate"] {
+        assert!(tally.ok_by_function.get(f).copied().unwrap_or(0) >= count / 20, "{f}: {:?}", tally.ok_by_function);
+    }
+    assert!(tally.by_status.get("Error").copied().unwrap_or(0) > count / 10, "{:?}", tally.by_status);
+}
