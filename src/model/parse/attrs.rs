@@ -104,13 +104,29 @@ impl<'a> El<'a> {
         self.get(name).ok_or_else(|| self.err(format!("missing required attribute '{name}'")))
     }
 
-    /// Position of character `char_off` of attribute `a`'s value.
+    /// Position of character `char_off` of attribute `a`'s value (as read: entities
+    /// replaced, line ends normalized), found by walking the value as written: an entity
+    /// (`&lt;`, `&#43;`, ...) and a `\r\n` line end are one character of the value.
     pub fn value_pos(&self, a: &XAttr, char_off: usize) -> SrcPos {
         let Some(start) = a.value_off else {
             return a.pos;
         };
         let rest = self.src.text.get(start..).unwrap_or("");
-        let byte = rest.char_indices().nth(char_off).map_or(rest.len(), |(b, _)| b);
+        let mut byte = 0;
+        for _ in 0..char_off {
+            let r = &rest[byte..];
+            byte += if r.starts_with("\r\n") {
+                2
+            } else if r.starts_with('&') {
+                // The value was unescaped without error: every `&` starts an entity.
+                r.find(';').map_or(1, |i| i + 1)
+            } else {
+                match r.chars().next() {
+                    Some(c) => c.len_utf8(),
+                    None => break,
+                }
+            };
+        }
         self.src.pos(start + byte)
     }
 
