@@ -42,12 +42,11 @@ const MAX_DEPTH: usize = 32;
 
 /// Parse the whole text; returns the single root element.
 pub(crate) fn read(src: &Source) -> Result<XElem, ModelError> {
-    // The reader gets the text after a UTF-8 byte order mark, and `base` turns its
-    // offsets back into offsets of the whole text (quick-xml would skip the mark itself
-    // and count from after it, putting every position it reports 3 bytes early).
-    let body = src.text.strip_prefix('\u{feff}').unwrap_or(src.text);
-    let base = src.text.len() - body.len();
-    let mut reader = Reader::from_str(body);
+    // quick-xml skips one leading UTF-8 byte order mark and counts its offsets from after
+    // it: `base` turns them into offsets of the whole text. (Stripping the mark here
+    // instead would let quick-xml skip a second one, uncounted.)
+    let base = if src.text.starts_with('\u{feff}') { '\u{feff}'.len_utf8() } else { 0 };
+    let mut reader = Reader::from_str(src.text);
     let mut stack: Vec<XElem> = Vec::new();
     let mut root: Option<XElem> = None;
     loop {
