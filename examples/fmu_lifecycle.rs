@@ -22,21 +22,15 @@ use mbfmu::fmi::exports_common::*;
 use mbfmu::fmi::exports_cs::*;
 use mbfmu::fmi::exports_state::*;
 use mbfmu::fmi::guid::guid;
-use mbfmu::fmi::types::{CO_SIMULATION, CallbackFunctions, Component, FmuStatePtr, Status};
+use mbfmu::fmi::types::{CO_SIMULATION, Component, FmuStatePtr, Status};
 use mbfmu::fmi::variables::{Causality, Variable, variables};
 use std::ffi::CString;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
-/// No logger: its C type is variadic, which stable Rust cannot define. The messages are
-/// still queued and kept by the instance (read with `last_messages`).
-const CALLBACKS: CallbackFunctions = CallbackFunctions {
-    logger: None,
-    allocate_memory: None,
-    free_memory: None,
-    step_finished: None,
-    component_environment: std::ptr::null_mut(),
-};
+#[path = "../tests/common/host.rs"]
+mod host;
+use host::{CALLBACKS, resources};
 
 /// Communication step size.
 const H: f64 = 0.01;
@@ -54,17 +48,6 @@ fn ok(c: Component, status: Status, what: &str) {
     if status != Status::Ok {
         fail(c, &format!("{what} returned {status:?}"));
     }
-}
-
-/// A resources directory holding `text` as model.xml, under a fresh temporary directory
-/// (removed by the caller); its file:// URI with a space and '%' escaped.
-fn resources(text: &str) -> (PathBuf, CString) {
-    let top = std::env::temp_dir().join(format!("mbfmu lifecycle {}", std::process::id()));
-    let dir = top.join("resources");
-    std::fs::create_dir_all(&dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
-    std::fs::write(dir.join("model.xml"), text).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
-    let path = dir.to_str().expect("UTF-8 temporary directory").replace('%', "%25").replace(' ', "%20");
-    (top, CString::new(format!("file://{path}")).expect("no NUL in the path"))
 }
 
 fn instantiate(guid_s: &str, uri: &CString) -> Component {
@@ -296,7 +279,7 @@ impl Plan {
 
 /// The lifecycle of the module's documentation, through the C API only; a summary.
 fn lifecycle(p: &Plan) -> String {
-    let (top, uri) = resources(&p.text);
+    let (top, uri) = resources(&p.text, "lifecycle");
     // A refused instantiation (wrong GUID): NULL, with its message built and dropped.
     if !instantiate("{00000000-0000-0000-0000-000000000000}", &uri).is_null() {
         fail(std::ptr::null_mut(), "fmi2Instantiate accepted a wrong GUID");

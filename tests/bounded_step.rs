@@ -10,12 +10,16 @@ use mbfmu::fmi::exports_state::*;
 use mbfmu::fmi::guid::guid;
 use mbfmu::fmi::model_description::write;
 use mbfmu::fmi::state_machine::State;
-use mbfmu::fmi::types::{CO_SIMULATION, CallbackFunctions, Component, LAST_SUCCESSFUL_TIME, Status};
+use mbfmu::fmi::types::{CO_SIMULATION, Component, LAST_SUCCESSFUL_TIME, Status};
 use mbfmu::fmi::variables::{MAX_STEPS_NAME, variables};
 use mbfmu::model::parse::load_str;
 use std::ffi::CString;
 use std::path::PathBuf;
 use std::time::Instant;
+
+#[path = "common/host.rs"]
+mod host;
+use host::{CALLBACKS, resources};
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -60,31 +64,8 @@ fn angle_diff(a: f64, b: f64) -> f64 {
     if d > std::f64::consts::PI { d - tau } else { d }
 }
 
-/// `<tmp>/resources/model.xml` of a model text; its `file://` URI.
-fn resources(text: &str) -> CString {
-    let id: String = guid(text).chars().filter(char::is_ascii_hexdigit).collect();
-    let dir = std::env::temp_dir().join(format!("mbfmu-bounded-{}-{id}", std::process::id())).join("resources");
-    std::fs::create_dir_all(&dir).unwrap();
-    let file = dir.join("model.xml");
-    if !file.exists() {
-        // Write then rename: tests running in parallel never read a half-written file.
-        let tmp = dir.join(format!("model.{:?}.tmp", std::thread::current().id()));
-        std::fs::write(&tmp, text).unwrap();
-        std::fs::rename(&tmp, &file).unwrap();
-    }
-    CString::new(format!("file://{}", dir.to_str().unwrap())).unwrap()
-}
-
-const CALLBACKS: CallbackFunctions = CallbackFunctions {
-    logger: None,
-    allocate_memory: None,
-    free_memory: None,
-    step_finished: None,
-    component_environment: std::ptr::null_mut(),
-};
-
 fn instantiate(text: &str) -> Component {
-    let (g, uri) = (CString::new(guid(text)).unwrap(), resources(text));
+    let (g, uri) = (CString::new(guid(text)).unwrap(), resources(text, "bounded").1);
     // SAFETY: valid NUL-terminated strings and callbacks; logging on (every category).
     let c = unsafe { fmi2Instantiate(c"bounded".as_ptr(), CO_SIMULATION, g.as_ptr(), uri.as_ptr(), &CALLBACKS, 0, 1) };
     assert!(!c.is_null());

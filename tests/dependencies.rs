@@ -6,11 +6,15 @@ use mbfmu::fmi::exports_common::*;
 use mbfmu::fmi::exports_cs::*;
 use mbfmu::fmi::guid::guid;
 use mbfmu::fmi::model_description::write;
-use mbfmu::fmi::types::{CO_SIMULATION, CallbackFunctions, Component, Status};
+use mbfmu::fmi::types::{CO_SIMULATION, Component, Status};
 use mbfmu::model::parse::load_str;
 use std::collections::BTreeMap;
 use std::ffi::CString;
 use std::path::PathBuf;
+
+#[path = "common/host.rs"]
+mod host;
+use host::{CALLBACKS, resources};
 
 /// Two pendulums that do not touch: `a` hangs freely; `b` is driven by the input T. The
 /// input U is read by an output only.
@@ -119,23 +123,6 @@ fn two_separate_pendulums_get_separate_dependency_lists() {
     assert_eq!(outputs[&5], [1, 11, 12, 13, 14], "{xml}");
 }
 
-/// `<dir>/resources/model.xml` for a model text; its `file://` URI.
-fn resources(text: &str) -> CString {
-    let id: String = guid(text).chars().filter(char::is_ascii_hexdigit).collect();
-    let dir = std::env::temp_dir().join(format!("mbfmu-deps-{}-{id}", std::process::id())).join("resources");
-    std::fs::create_dir_all(&dir).unwrap();
-    std::fs::write(dir.join("model.xml"), text).unwrap();
-    CString::new(format!("file://{}", dir.to_str().unwrap())).unwrap()
-}
-
-const CALLBACKS: CallbackFunctions = CallbackFunctions {
-    logger: None,
-    allocate_memory: None,
-    free_memory: None,
-    step_finished: None,
-    component_environment: std::ptr::null_mut(),
-};
-
 /// Every directional derivative outside the declared dependencies of `text`'s FMU, after
 /// `t_end` s of motion: (checked entries, entries that are not exactly zero).
 fn undeclared_entries(text: &str, t_end: f64) -> (usize, Vec<String>) {
@@ -154,7 +141,7 @@ fn undeclared_entries(text: &str, t_end: f64) -> (usize, Vec<String>) {
         .collect();
     knowns.extend(&states);
     assert_eq!(states.len(), derivatives.len());
-    let (name, g, uri) = (c"deps", CString::new(guid(text)).unwrap(), resources(text));
+    let (name, g, uri) = (c"deps", CString::new(guid(text)).unwrap(), resources(text, "deps").1);
     // SAFETY: valid strings and callbacks; the instance lives until freed below, and every
     // array passed has the length given with it.
     unsafe {

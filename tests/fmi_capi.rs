@@ -9,41 +9,20 @@ use mbfmu::fmi::exports_me::fmi2SetTime;
 use mbfmu::fmi::exports_state::*;
 use mbfmu::fmi::guid::guid;
 use mbfmu::fmi::state_machine::State;
-use mbfmu::fmi::types::{CO_SIMULATION, CallbackFunctions, Component, LAST_SUCCESSFUL_TIME, MODEL_EXCHANGE, Status};
+use mbfmu::fmi::types::{CO_SIMULATION, Component, LAST_SUCCESSFUL_TIME, MODEL_EXCHANGE, Status};
 use std::ffi::CString;
 use std::path::PathBuf;
+
+#[path = "common/host.rs"]
+mod host;
+use host::{CALLBACKS, resources};
 
 fn model_text(name: &str) -> String {
     std::fs::read_to_string(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("models").join(name)).unwrap()
 }
 
-/// `<dir with a space and a %>/resources/model.xml` (one per model text); its `file://`
-/// URI with the space and the `%` escaped.
-fn resources(text: &str) -> CString {
-    let id: String = guid(text).chars().filter(char::is_ascii_hexdigit).collect();
-    let dir = std::env::temp_dir().join(format!("mbfmu capi 100% {} {id}", std::process::id())).join("resources");
-    std::fs::create_dir_all(&dir).unwrap();
-    let file = dir.join("model.xml");
-    if !file.exists() {
-        // Write then rename: tests running in parallel never read a half-written file.
-        let tmp = dir.join(format!("model.{:?}.tmp", std::thread::current().id()));
-        std::fs::write(&tmp, text).unwrap();
-        std::fs::rename(&tmp, &file).unwrap();
-    }
-    let path = dir.to_str().unwrap().replace('%', "%25").replace(' ', "%20");
-    CString::new(format!("file://{path}")).unwrap()
-}
-
-const CALLBACKS: CallbackFunctions = CallbackFunctions {
-    logger: None,
-    allocate_memory: None,
-    free_memory: None,
-    step_finished: None,
-    component_environment: std::ptr::null_mut(),
-};
-
 fn instantiate_with(text: &str, fmu_type: i32, guid_s: &str) -> Component {
-    let (name, g, uri) = (c"inst", CString::new(guid_s).unwrap(), resources(text));
+    let (name, g, uri) = (c"inst", CString::new(guid_s).unwrap(), resources(text, "capi").1);
     // SAFETY: valid NUL-terminated strings and callbacks.
     unsafe { fmi2Instantiate(name.as_ptr(), fmu_type, g.as_ptr(), uri.as_ptr(), &CALLBACKS, 0, 1) }
 }

@@ -15,13 +15,17 @@ use mbfmu::fmi::exports_me::*;
 use mbfmu::fmi::exports_state::*;
 use mbfmu::fmi::guid::guid;
 use mbfmu::fmi::types::{
-    CO_SIMULATION, CallbackFunctions, Component, DO_STEP_STATUS, FmuStatePtr, LAST_SUCCESSFUL_TIME, Status, TERMINATED,
+    CO_SIMULATION, Component, DO_STEP_STATUS, FmuStatePtr, LAST_SUCCESSFUL_TIME, Status, TERMINATED,
 };
 use mbfmu::fmi::variables::{Causality, variables};
 use std::collections::BTreeMap;
 use std::ffi::CString;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
+
+#[path = "common/host.rs"]
+mod host;
+use host::{CALLBACKS, resources};
 
 /// The longest any single call may take. A doStep is bounded by `solver.maxSteps`; the
 /// sequences set it to at most [`MAX_STEPS`] (or leave the default), so on these models a
@@ -87,9 +91,7 @@ fn models() -> Vec<Model> {
         .map(|path| {
             let text = std::fs::read_to_string(path).unwrap();
             let name = path.file_stem().unwrap().to_string_lossy().to_string();
-            let dir = std::env::temp_dir().join(format!("mbfmu-seq-{}-{name}", std::process::id())).join("resources");
-            std::fs::create_dir_all(&dir).unwrap();
-            std::fs::write(dir.join("model.xml"), &text).unwrap();
+            let (_, uri) = resources(&text, "sequences");
             let m = mbfmu::model::parse::load_str(&text, "model.xml").unwrap();
             let vars = variables(&m);
             let vr = |f: &dyn Fn(&mbfmu::fmi::variables::Variable) -> bool| {
@@ -97,7 +99,7 @@ fn models() -> Vec<Model> {
             };
             let max_steps = vars.iter().find(|v| v.name == "solver.maxSteps").map(|v| v.value_reference);
             Model {
-                uri: CString::new(format!("file://{}", dir.display())).unwrap(),
+                uri,
                 guid: CString::new(guid(&text)).unwrap(),
                 reals: vr(&|v| Some(v.value_reference) != max_steps),
                 parameters: vr(&|v| v.causality == Causality::Parameter && Some(v.value_reference) != max_steps),
@@ -111,14 +113,6 @@ fn models() -> Vec<Model> {
         })
         .collect()
 }
-
-const CALLBACKS: CallbackFunctions = CallbackFunctions {
-    logger: None,
-    allocate_memory: None,
-    free_memory: None,
-    step_finished: None,
-    component_environment: std::ptr::null_mut(),
-};
 
 /// What the run saw.
 #[derive(Default)]

@@ -15,23 +15,19 @@
 use mbfmu::fmi::exports_common::*;
 use mbfmu::fmi::exports_state::*;
 use mbfmu::fmi::guid::guid;
-use mbfmu::fmi::types::{CO_SIMULATION, CallbackFunctions, Component, FmuStatePtr, Status};
+use mbfmu::fmi::types::{CO_SIMULATION, Component, FmuStatePtr, Status};
 use std::ffi::CString;
 use std::path::PathBuf;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
+#[path = "common/host.rs"]
+mod host;
+use host::{CALLBACKS, resources};
+
 /// One measurement at a time: they see the whole process.
 static SERIAL: Mutex<()> = Mutex::new(());
-
-const CALLBACKS: CallbackFunctions = CallbackFunctions {
-    logger: None,
-    allocate_memory: None,
-    free_memory: None,
-    step_finished: None,
-    component_environment: std::ptr::null_mut(),
-};
 
 /// Resident set size in bytes (/proc/self/statm, second field, in pages).
 fn rss() -> usize {
@@ -81,12 +77,8 @@ impl Fmu {
     fn new(test: &str) -> Fmu {
         let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
         let text = std::fs::read_to_string(root.join("models/pendulum.xml")).unwrap();
-        let dir = std::env::temp_dir().join(format!("mbfmu memory rss {} {test}", std::process::id()));
-        let res = dir.join("resources");
-        std::fs::create_dir_all(&res).unwrap();
-        std::fs::write(res.join("model.xml"), &text).unwrap();
-        let path = res.to_str().unwrap().replace('%', "%25").replace(' ', "%20");
-        Fmu { guid: CString::new(guid(&text)).unwrap(), uri: CString::new(format!("file://{path}")).unwrap(), dir }
+        let (dir, uri) = resources(&text, &format!("memory rss {test}"));
+        Fmu { guid: CString::new(guid(&text)).unwrap(), uri, dir }
     }
 
     fn instantiate(&self) -> Component {
