@@ -77,7 +77,7 @@ struct Model {
     outputs: Vec<u32>,
     knowns: Vec<u32>,
     unknowns: Vec<u32>,
-    /// `solver.maxSteps` (Integer), when the FMU has it.
+    /// `solver.maxSteps`, the FMU's one Integer variable.
     max_steps: Option<u32>,
 }
 
@@ -97,7 +97,7 @@ fn models() -> Vec<Model> {
             let vr = |f: &dyn Fn(&mbfmu::fmi::variables::Variable) -> bool| {
                 vars.iter().filter(|v| f(v)).map(|v| v.value_reference).collect::<Vec<u32>>()
             };
-            let max_steps = vars.iter().find(|v| v.name == "solver.maxSteps").map(|v| v.value_reference);
+            let max_steps = vars.iter().find(|v| v.target.is_integer()).map(|v| v.value_reference);
             Model {
                 uri,
                 guid: CString::new(guid(&text)).unwrap(),

@@ -2,8 +2,7 @@
 
 use super::equations::{self, Layout};
 use super::init;
-use super::radau::DEFAULT_MAX_STEPS;
-use super::radau::{DaeProblem, Radau, Stats};
+use super::radau::{DEFAULT_MAX_STEPS, DaeProblem, Radau, Stats};
 use super::sparse::{SparseLu, Triplets};
 use crate::ad::Real;
 use crate::geom::{M3, V3, rot313};
