@@ -3,10 +3,18 @@
 //! u = T(q) q̇ (Eq. 12) with T = blockdiag(I, B(θ, φ)); we use H = T⁻¹.
 
 use crate::ad::Real;
-use crate::geom::{M3, V3, rot313};
+use crate::geom::{M3, V3, rot_x, rot313};
 
 /// Number of coordinates (and velocities) per body.
 pub const NQ: usize = 6;
+
+/// Angles (0, π/2, 0): far from the 3-1-3 singularity; R0 is chosen so a body starts there.
+pub const FAR_FROM_SINGULAR: [f64; 3] = [0.0, std::f64::consts::FRAC_PI_2, 0.0];
+
+/// R0 such that R0 · R313(FAR_FROM_SINGULAR) = `a`.
+pub fn rebased_reference(a: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
+    M3::cst(a).mm(&rot_x(std::f64::consts::FRAC_PI_2).t()).val()
+}
 
 /// Ground position and rotation of a body from its coordinates: A = R0 · Rz(ψ)Rx(θ)Rz(φ).
 pub fn body_frame<T: Real>(q: &[T], r0: &[[f64; 3]; 3]) -> (V3<T>, M3<T>) {

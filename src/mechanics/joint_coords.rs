@@ -25,9 +25,11 @@ pub struct JointCoord {
     pub name: String,
     /// What it measures, frame stated (for FMI variable descriptions).
     pub about: String,
+    /// The measure of i relative to j.
     pub f: Expr,
     /// First angle-unwrapping slot of `f`.
     pub abase: usize,
+    /// Its rank among the internal candidates.
     pub rank: CoordRank,
 }
 

@@ -11,9 +11,6 @@ use super::system::System;
 use super::user::UserEq;
 use crate::ad::{Dual, Real};
 
-/// Most bodies one element may touch (the model reader enforces it, with a location).
-pub const MAX_ELEMENT_BODIES: usize = crate::model::MAX_ELEMENT_BODIES;
-
 /// Gather the local coordinates of `bodies` from a global vector (6 per body).
 pub fn gather(bodies: &[usize], x: &[f64]) -> Vec<f64> {
     bodies.iter().flat_map(|&b| x[NQ * b..NQ * b + NQ].iter().copied()).collect()
@@ -21,14 +18,19 @@ pub fn gather(bodies: &[usize], x: &[f64]) -> Vec<f64> {
 
 /// C, C_q (local, row-major neq × 6nb) and C_t of one constraint element.
 pub struct ConstraintFirst {
+    /// C (neq).
     pub c: Vec<f64>,
+    /// C_q, neq × 6nb.
     pub cq: Vec<f64>,
+    /// C_t (neq).
     pub ct: Vec<f64>,
 }
 
 /// C with gradient and Hessian over z = (local q, t); K = 6nb + 1.
 pub struct ConstraintSecond {
+    /// Number K of variables z.
     pub k: usize,
+    /// C (neq).
     pub c: Vec<f64>,
     /// neq × K.
     pub grad: Vec<f64>,
@@ -244,8 +246,8 @@ pub fn gyroscopic(j: &[[f64; 3]; 3], w: &[f64]) -> ([f64; 3], [f64; 9]) {
     (g.val(), std::array::from_fn(|i| g.0[i / 3].d[i % 3]))
 }
 
-/// ∂Q/∂w of one force element for each external value w it reads (inputs and user
-/// unknowns, see [`System::ext`]): (index into `ext`, 6nb entries).
+/// ∂Q/∂w of one force element for each external value w it reads (`ForceEl::ext_refs`,
+/// see [`System::ext`]): (index into `ext`, 6nb entries).
 pub fn force_ext_jacobian(
     sys: &System,
     el: &ForceEl,
@@ -287,8 +289,11 @@ pub fn user_residual(sys: &System, ue: &UserEq, q: &[f64], u: &[f64], t: f64, ex
 /// Exact derivatives of a user row: ∂r/∂(local q, local u) (12nb) and ∂r/∂w for each
 /// external value it reads.
 pub struct UserJacobian {
+    /// The residual r.
     pub value: f64,
+    /// ∂r/∂(local q, local u): 12nb entries (all q, then all u).
     pub dqu: Vec<f64>,
+    /// (index into `ext`, ∂r/∂w) for each external value w in `UserEq::ext_refs`.
     pub dext: Vec<(usize, f64)>,
 }
 

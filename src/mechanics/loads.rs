@@ -20,22 +20,9 @@ use super::local::LocalCtx;
 use super::system::{ElementSlot, System};
 use crate::ad::{Dual, Real};
 use crate::geom::V3;
-use crate::model::expr::{ElementRef, ExprEnv, LoadFn};
+use crate::model::expr::{ElementRef, ExprEnv};
 
-/// Number of load components: force x y z, torque x y z.
-pub const NLOAD: usize = 6;
-
-/// Position of `f` among the six components (fx fy fz tx ty tz).
-pub fn load_index(f: LoadFn) -> usize {
-    match f {
-        LoadFn::Fx => 0,
-        LoadFn::Fy => 1,
-        LoadFn::Fz => 2,
-        LoadFn::Tx => 3,
-        LoadFn::Ty => 4,
-        LoadFn::Tz => 5,
-    }
-}
+pub use super::load_components::{NLOAD, load_index};
 
 /// An element's load and its exact gradient at one point.
 #[derive(Clone, Debug)]

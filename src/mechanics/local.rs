@@ -3,6 +3,8 @@
 //! [`ExprEnv`] that expressions read.
 
 use super::body::{NQ, body_frame};
+use super::external::ExtLayout;
+use super::load_components::load_index;
 use super::system::System;
 use crate::ad::Real;
 use crate::geom::{M3, V3};
@@ -31,14 +33,19 @@ pub type AngleRecord = RefCell<Vec<(usize, f64, f64)>>;
 
 /// Element-local evaluation context.
 pub struct LocalCtx<'a, T: Real> {
+    /// The system the element belongs to.
     pub sys: &'a System,
     /// Global indices of the bodies this context holds, in local order.
     pub ids: &'a [usize],
+    /// State of each body in `ids`, same order.
     pub bodies: Vec<LocalBody<T>>,
+    /// Time.
     pub t: T,
-    /// External values `ext` = [inputs; user unknowns Z = (X, dX/dt, V)] (see
-    /// [`System::ext`]); a shorter slice (inputs only) reads user unknowns as NaN.
+    /// External values ext = [inputs; Z; L] (layout: [`ExtLayout`], values:
+    /// [`System::ext`]); a shorter slice (e.g. inputs only) reads the missing entries as NaN.
     pub inputs: &'a [f64],
+    /// Layout of `inputs`.
+    ext: ExtLayout,
     /// Element loads for `fx(...)` (outputs only), as scalars of this context (constants,
     /// or dual numbers seeded on the loads themselves); `None` reads as NaN.
     pub loads: Option<&'a dyn Fn(LoadFn, ElementRef) -> T>,
@@ -75,6 +82,7 @@ impl<'a, T: Real> LocalCtx<'a, T> {
             bodies,
             t,
             inputs,
+            ext: sys.ext_layout(),
             loads: None,
             has_udot: !udot.is_empty(),
             angle_base: Cell::new(0),
@@ -121,16 +129,16 @@ impl<T: Real> ExprEnv<T> for LocalCtx<'_, T> {
         T::cst(self.sys.params[i])
     }
     fn input(&self, i: usize) -> T {
-        self.ext_value(i)
+        self.ext_value(self.ext.input(i))
     }
     fn variable(&self, i: usize) -> T {
-        self.ext_value(self.sys.ext_variable(i))
+        self.ext_value(self.ext.variable(i))
     }
     fn diff(&self, i: usize) -> T {
-        self.ext_value(self.sys.ext_diff(i))
+        self.ext_value(self.ext.diff(i))
     }
     fn diff_dot(&self, i: usize) -> T {
-        self.ext_value(self.sys.ext_diff_dot(i))
+        self.ext_value(self.ext.diff_dot(i))
     }
     fn pose(&self, m: MarkerId) -> Pose<T> {
         let g = &self.sys.markers[m];
@@ -171,7 +179,7 @@ impl<T: Real> ExprEnv<T> for LocalCtx<'_, T> {
         match self.loads {
             Some(l) => l(f, e),
             // Forces and user rows read loads as external values (see `System::load_refs`).
-            None => match self.sys.ext_load_of(e, super::loads::load_index(f)) {
+            None => match self.sys.ext_load_of(e, load_index(f)) {
                 Some(k) => self.ext_value(k),
                 None => T::cst(f64::NAN),
             },

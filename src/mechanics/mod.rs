@@ -2,17 +2,46 @@
 //! Jacobians, generalized forces Q and the kinematic map T (Eq. 1, 12, 13a–13e).
 //! Every element is evaluated generically over [`crate::ad::Real`]; derivatives come
 //! from [`crate::ad::Dual`] numbers through the kernels in [`kernels`].
+//!
+//! Files bottom-up (each uses only files above it):
+//! - [`body`]: body coordinates q, u, the map H = T⁻¹ and the reference frames R0.
+//! - [`load_components`]: the six components of an element load and their order.
+//! - [`joint_coords`]: the free coordinates of each joint, as expressions.
+//! - [`constraints`]: holonomic constraint elements and velocity initial conditions (data).
+//! - [`nonholonomic`]: non-holonomic constraint elements (data).
+//! - [`forces`]: force elements (data).
+//! - [`user`]: user rows, differentials and variables (data).
+//! - [`system`]: the [`System`] struct: elements, row and slot layout, per-simulation state.
+//! - [`external`]: layout of the external values [inputs; Z; L] ([`external::ExtLayout`]).
+//! - [`from_model`]: [`System::from_model`], step by step.
+//! - [`local`]: the element context [`local::LocalCtx`] that element equations read.
+//! - [`nonholonomic_equations`]: equations g of the non-holonomic elements, wheel contact.
+//! - [`constraint_equations`]: equations C of the constraint elements and velocity ICs.
+//! - [`force_laws`]: loads and generalized forces of the force elements.
+//! - [`user_rows`]: residuals of the user rows.
+//! - [`kernels`]: exact derivatives of the element equations (forward-mode AD).
+//! - [`loads`]: element loads `fx(name)` … and their exact gradients.
+//! - [`external_values`]: [`System::ext`], the external values at a state.
+//! - [`components`]: connected components of the mechanism.
 
 pub mod body;
 pub mod components;
+pub mod constraint_equations;
 pub mod constraints;
+pub mod external;
+pub mod external_values;
+pub mod force_laws;
 pub mod forces;
+pub mod from_model;
 pub mod joint_coords;
 pub mod kernels;
+pub mod load_components;
 pub mod loads;
 pub mod local;
 pub mod nonholonomic;
+pub mod nonholonomic_equations;
 pub mod system;
 pub mod user;
+pub mod user_rows;
 
 pub use system::{MarkerGeom, System};
