@@ -163,3 +163,26 @@ impl System {
         self.load_refs.iter().position(|x| *x == e).map(|k| self.ext_layout().load(k) + c)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_entry_is_where_its_index_says() {
+        let lay = ExtLayout::new(2, 3, 1, 2, 1);
+        assert_eq!((lay.nz(), lay.len()), (2 * 3 + 1 + 12, 2 + 19 + 6));
+        assert_eq!((lay.z_range(), lay.loads_range()), (2..21, 21..27));
+        let mut at = Vec::new();
+        at.extend((0..2).map(|i| (lay.input(i), ExtEntry::Input(i))));
+        at.extend((0..3).map(|i| (lay.diff(i), ExtEntry::Z(i))));
+        at.extend((0..3).map(|i| (lay.diff_dot(i), ExtEntry::Z(3 + i))));
+        at.push((lay.variable(0), ExtEntry::Z(6)));
+        at.extend((0..2).flat_map(|k| (0..NQ).map(move |c| (lay.acc(k) + c, ExtEntry::Z(7 + NQ * k + c)))));
+        at.extend((0..NLOAD).map(|c| (lay.load(0) + c, ExtEntry::Load(0, c))));
+        assert_eq!(at.iter().map(|&(e, _)| e).collect::<Vec<_>>(), (0..lay.len()).collect::<Vec<_>>());
+        for (e, what) in at {
+            assert_eq!(lay.entry(e), what);
+        }
+    }
+}
