@@ -11,23 +11,24 @@ pub mod select;
 pub mod select_velocity;
 pub mod states;
 pub mod tiers;
+pub mod tolerances;
 
 pub use augmented::{Linearization, linearize};
 pub use candidates::Candidates;
 pub use select::{Selection, select_states, select_states_among};
 
-use crate::dae::{EngineError, SimOptions, Simulator};
+use crate::dae::{EngineError, Simulator};
 use crate::mechanics::System;
 use crate::model::Model;
 use jets::jets;
 use states::{VelState, internal_state, joint_states, user_states};
 
-/// The states an FMU of `model` exposes: selected (Eq. 33) from the assembled initial
-/// configuration with the model's own parameter values and experiment start.
+/// The linearization states of `model`, as both `mbfmu linearize` and its FMU use them:
+/// selected (Eq. 33) from the initial configuration assembled with the model's own
+/// parameter and input values at its experiment start, with [`tolerances::SELECTION_TOL`].
 pub fn selection_at_start(model: &Model) -> Result<Selection, EngineError> {
     let t0 = model.experiment.start.unwrap_or(0.0);
-    let tol = model.experiment.tolerance.unwrap_or(SimOptions::default().tol);
-    let sim = Simulator::new(model, SimOptions { tol, max_step: None, ..Default::default() }, t0)?;
+    let sim = Simulator::new(model, tolerances::selection_options(), t0)?;
     select_states(sim.system(), sim.q(), t0, &sim.inputs()).map_err(EngineError::Numeric)
 }
 
@@ -69,7 +70,15 @@ pub fn selection_by_name(sys: &System, names: &[String], w_names: &[String]) -> 
             selection_by_name(sys, &[inner.to_string()], &[]).map(|sel| VelState::Derivative(sel.states[0].clone()))
         })
         .collect::<Result<Vec<_>, String>>()?;
-    Ok(Selection { states, velocities, dropped: vec![], rank: sys.redundant.iter().filter(|r| !**r).count() })
+    let velocity_of = velocities
+        .iter()
+        .map(|w| match w {
+            VelState::Derivative(d) => states.iter().position(|s| s == d),
+            VelState::User(_) => None,
+        })
+        .collect();
+    let rank = sys.redundant.iter().filter(|r| !**r).count();
+    Ok(Selection::new(states, velocities, velocity_of, vec![], rank))
 }
 
 /// Values at the current point of the position states S, their rates Ṡ, the velocity
