@@ -12,6 +12,7 @@ use mbfmu::fmi::model_description::write;
 use mbfmu::fmi::state_machine::State;
 use mbfmu::fmi::types::{CO_SIMULATION, Component, LAST_SUCCESSFUL_TIME, Status};
 use mbfmu::fmi::variables::{MAX_STEPS_NAME, variables};
+use mbfmu::linearize::StateLayout;
 use mbfmu::model::parse::load_str;
 use std::ffi::CString;
 use std::path::PathBuf;
@@ -85,7 +86,11 @@ fn initialize(c: Component, tol: f64) {
 /// Value reference of variable `name` of the model `text`.
 fn vr(text: &str, name: &str) -> u32 {
     let model = load_str(text, "model.xml").unwrap();
-    variables(&model).iter().find(|v| v.name == name).unwrap_or_else(|| panic!("no variable {name}")).value_reference
+    variables(&model, &StateLayout::at_start(&model))
+        .iter()
+        .find(|v| v.name == name)
+        .unwrap_or_else(|| panic!("no variable {name}"))
+        .value_reference
 }
 
 fn get(c: Component, vrs: &[u32]) -> Vec<f64> {
@@ -128,7 +133,7 @@ fn free(c: Component) {
 fn solver_max_steps_is_the_last_variable_an_integer_tunable_parameter() {
     for text in [toggle_text(), model_text("cart_pendulum_pid.xml")] {
         let model = load_str(&text, "model.xml").unwrap();
-        let vars = variables(&model);
+        let vars = variables(&model, &StateLayout::at_start(&model));
         let last = vars.last().unwrap();
         assert_eq!(last.name, MAX_STEPS_NAME);
         assert_eq!(last.value_reference as usize, vars.len() - 1, "value reference = index");

@@ -93,7 +93,7 @@ fn models() -> Vec<Model> {
             let name = path.file_stem().unwrap().to_string_lossy().to_string();
             let (_, uri) = resources(&text, "sequences");
             let m = mbfmu::model::parse::load_str(&text, "model.xml").unwrap();
-            let vars = variables(&m);
+            let vars = variables(&m, &mbfmu::linearize::StateLayout::at_start(&m));
             let vr = |f: &dyn Fn(&mbfmu::fmi::variables::Variable) -> bool| {
                 vars.iter().filter(|v| f(v)).map(|v| v.value_reference).collect::<Vec<u32>>()
             };

@@ -87,7 +87,10 @@ fn pack_writes_the_fmu_zip_and_directory() {
 
     let entries = unzip(&fmu);
     let names: Vec<&str> = entries.iter().map(|(n, _)| n.as_str()).collect();
-    assert_eq!(names, ["modelDescription.xml", "binaries/linux64/pendulum.so", "resources/model.xml"]);
+    assert_eq!(
+        names,
+        ["modelDescription.xml", "binaries/linux64/pendulum.so", "resources/model.xml", "resources/states.txt"]
+    );
     let model_bytes = std::fs::read(&model).expect("model readable");
     assert_eq!(entries[2].1, model_bytes, "resources/model.xml is the model file, byte for byte");
     assert_eq!(entries[1].1, std::fs::read(library()).expect("cdylib readable"), "the .so is the crate's cdylib");

@@ -12,7 +12,7 @@ from .errors import ArgumentError, FMUCallError, FMUNotFoundError, MbfmuError, N
 from .files import load, save
 from .linearization import EigenRow, Linearization
 from .linearize_fmu import DifferencesWarning, linearize
-from .pack import pack
+from .pack import PackWarning, pack
 from .sweep import Sweep, sweep
 from .system import linearize_system
 
@@ -25,6 +25,7 @@ __all__ = [
     "Linearization",
     "MbfmuError",
     "NotLinearizableError",
+    "PackWarning",
     "Sweep",
     "linearize",
     "linearize_system",

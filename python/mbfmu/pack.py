@@ -9,11 +9,17 @@ from __future__ import annotations
 import os
 import shutil
 import subprocess
+import warnings
 from pathlib import Path
 
 from .errors import ArgumentError, FMUNotFoundError, MbfmuError
 
 _REPO = Path(__file__).resolve().parents[2]
+
+
+class PackWarning(UserWarning):
+    """The FMU was packed but lacks something, e.g. linearization states because they could
+    not be selected at the model's start (the message says why, located in the model file)."""
 
 
 def cli() -> Path:
@@ -38,7 +44,8 @@ def cli() -> Path:
 def pack(model, out=None, out_dir=None) -> Path:
     """Pack `model` (an mbfmu model file) into the FMU `out` (default: the model's name
     with .fmu beside it); `out_dir` also writes the unzipped FMU there. Returns `out`.
-    A model error is raised as ArgumentError with the tool's `file:line:col` message."""
+    A model error is raised as ArgumentError with the tool's `file:line:col` message; what
+    the packed FMU lacks (the tool's warnings) is issued as a PackWarning."""
     model = Path(model)
     if not model.is_file():
         raise FMUNotFoundError(f"model file '{model}' does not exist")
@@ -51,4 +58,7 @@ def pack(model, out=None, out_dir=None) -> Path:
         raise ArgumentError(r.stderr.strip())
     if r.returncode != 0:
         raise MbfmuError(f"mbfmu pack failed (exit {r.returncode}): {r.stderr.strip()}")
+    for line in r.stderr.splitlines():
+        if line.startswith("warning: "):
+            warnings.warn(f"{model}: {line.removeprefix('warning: ')}", PackWarning, stacklevel=2)
     return out

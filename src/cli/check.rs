@@ -1,24 +1,22 @@
 //! `mbfmu check model.xml`: validate a model, assemble it, and print honest counts:
 //! equations, independent equations, the redundant ones by element, and the degrees of
-//! freedom at position and velocity level ([`crate::dae::counts`]).
+//! freedom at position and velocity level ([`crate::dae::counts`]), in the configuration
+//! the linearization states are selected from ([`selection_options`]).
 
 use std::io::Write;
 use std::path::Path;
 
 use super::CliError;
+use crate::dae::Simulator;
 use crate::dae::counts::{Counts, counts};
-use crate::dae::{SimOptions, Simulator};
+use crate::linearize::tolerances::selection_options;
 use crate::model::parse::load_file;
 
 /// Load, validate and assemble `path`, then print the model name and its counts to `out`.
 pub fn check(path: &Path, out: &mut dyn Write) -> Result<(), CliError> {
     let model = load_file(path)?;
     let t0 = model.experiment.start.unwrap_or(0.0);
-    let sim = Simulator::new(
-        &model,
-        SimOptions { tol: model.experiment.tolerance.unwrap_or(1e-8), max_step: None, ..Default::default() },
-        t0,
-    )?;
+    let sim = Simulator::new(&model, selection_options(), t0)?;
     super::print_warnings(&sim);
     let c = counts(sim.system(), sim.q(), sim.u(), t0, &sim.inputs(), &sim.ext());
     writeln!(out, "model '{}' ({}): ok", model.name, path.display())

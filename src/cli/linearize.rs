@@ -1,6 +1,7 @@
 //! `mbfmu linearize`: simulate to each requested time, linearize there in the states
-//! selected at the start (as an FMU would), print the chosen states and the eigenvalue
-//! table, and optionally write A, B, C, D (JSON, NumPy .npz, or MATLAB v4 .mat).
+//! selected at the start (the FMU's: [`selection_at_start`], whatever `--tol`), print the
+//! chosen states and the eigenvalue table, and optionally write A, B, C, D (JSON, NumPy
+//! .npz, or MATLAB v4 .mat).
 
 use std::io::Write;
 use std::path::PathBuf;
@@ -11,8 +12,11 @@ use super::CliError;
 use super::input_csv::InputTable;
 use crate::dae::{BATCH_MAX_STEPS, SimOptions, Simulator};
 use crate::linearize::eigen::{eigen_table, format_table};
-use crate::linearize::{Linearization, Selection, linearize, select_states, state_values};
+use crate::linearize::{Linearization, Selection, linearize, selection_at_start, state_values};
 use crate::model::parse::load_file;
+
+/// Integration tolerance when neither `--tol` nor the model's experiment gives one.
+pub const DEFAULT_TOL: f64 = 1e-8;
 
 /// Arguments of `mbfmu linearize`.
 #[derive(Debug, Args)]
@@ -28,7 +32,8 @@ pub struct LinearizeArgs {
     /// Where to write json/npz/mat (default: json to stdout; npz/mat need it).
     #[arg(long, short)]
     pub out: Option<PathBuf>,
-    /// Integration tolerance (default: the experiment's, else 1e-8).
+    /// Integration tolerance (default: the experiment's, else 1e-8). The states are
+    /// selected as in the FMU, whatever this is.
     #[arg(long)]
     pub tol: Option<f64>,
     /// Most integrator step attempts on the way to each time (and between input rows);
@@ -55,7 +60,7 @@ pub fn run(args: &LinearizeArgs, out: &mut dyn Write, report: &mut dyn Write) ->
     // --static: start from static equilibrium, as <analysis static="true"/> does.
     model.static_analysis |= args.r#static;
     let t0 = model.experiment.start.unwrap_or(0.0);
-    let tol = args.tol.or(model.experiment.tolerance).unwrap_or(1e-8);
+    let tol = args.tol.or(model.experiment.tolerance).unwrap_or(DEFAULT_TOL);
     if tol.is_nan() || tol <= 0.0 {
         return Err(CliError::Usage(format!("--tol must be positive, got {tol}")));
     }
@@ -76,7 +81,8 @@ pub fn run(args: &LinearizeArgs, out: &mut dyn Write, report: &mut dyn Write) ->
         t.apply(&mut sim)?;
     }
     super::print_warnings(&sim);
-    let sel = select_states(sim.system(), sim.q(), t0, &sim.inputs()).map_err(|e| CliError::Engine(e.into()))?;
+    // The FMU's states: selected on their own configuration, not on this run's tolerance.
+    let sel = selection_at_start(&model)?;
     let io_err = |e| CliError::io("writing output", e);
     let json_stdout = args.format == "json" && args.out.is_none();
     let rep: &mut dyn Write = if json_stdout { &mut *report } else { &mut *out };

@@ -35,9 +35,11 @@ impl From<PackError> for CliError {
     }
 }
 
-/// Pack the FMU and print one line: modelIdentifier, GUID and where it was written.
+/// Pack the FMU and print one line: modelIdentifier, GUID and where it was written (and
+/// what the FMU lacks, as warnings on stderr).
 pub fn run(args: &PackArgs, out: &mut dyn Write) -> Result<(), CliError> {
     let packed = pack(&args.model, args.out.as_deref(), args.out_dir.as_deref())?;
+    packed.warnings.iter().for_each(|w| eprintln!("warning: {w}"));
     let dest: Vec<String> = args.out.iter().chain(&args.out_dir).map(|p| p.display().to_string()).collect();
     writeln!(out, "packed FMU '{}' guid {} -> {}", packed.model_identifier, packed.guid, dest.join(", "))
         .map_err(|e| CliError::io("writing to stdout", e))

@@ -8,7 +8,7 @@ use super::CliError;
 use super::simulate::{RunSettings, drive, header};
 use crate::dae::{SimOptions, Simulator};
 use crate::linearize::eigen::{eigen_table, format_table};
-use crate::linearize::{linearize, select_states};
+use crate::linearize::{linearize, selection_at_start};
 use crate::model::parse::load_str;
 
 /// Name under which the embedded model reports errors.
@@ -36,7 +36,7 @@ pub fn run(out: &mut dyn Write) -> Result<(), CliError> {
     }
     let at_rest = model.with_params(&p).map_err(CliError::Usage)?;
     let mut sim = Simulator::new(&at_rest, SimOptions { tol: 1e-10, max_step: None, ..Default::default() }, 0.0)?;
-    let sel = select_states(sim.system(), sim.q(), 0.0, &sim.inputs()).map_err(|e| CliError::Engine(e.into()))?;
+    let sel = selection_at_start(&at_rest)?;
     let lin = linearize(&mut sim, &sel, 2)?;
     let rows = eigen_table(&lin.a).map_err(|e| CliError::Engine(e.into()))?;
     writeln!(out, "{DEFAULT_MODEL_FILE} at rest (th1 = th2 = 0), linearized in {}:", lin.states.join(", "))

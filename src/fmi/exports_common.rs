@@ -74,12 +74,12 @@ pub unsafe extern "C" fn fmi2Instantiate(
         // SAFETY: a NUL-terminated string or NULL per FMI.
         let name = unsafe { text(instanceName, "instanceName") };
         let sink = Sink::new(&callbacks, name.as_deref().unwrap_or("?"));
-        // Reading the model and naming its variables (an engine run) needs the engine's stack.
+        // Parsing the model (recursive over its expressions) needs the engine's stack.
         let made = with_stack(|| {
             // SAFETY: NUL-terminated strings or NULL per FMI.
-            let (model, guid) =
+            let (model, guid, layout) =
                 name.and_then(|name| unsafe { instantiate(&name, fmuType, fmuGUID, fmuResourceLocation) })?;
-            Ok::<_, String>(Instance::new(model, guid, Logger::new(loggingOn == TRUE)))
+            Ok::<_, String>(Instance::new(model, guid, layout, Logger::new(loggingOn == TRUE)))
         });
         match made {
             Ok(inst) => create(inst, sink),
@@ -92,7 +92,7 @@ pub unsafe extern "C" fn fmi2Instantiate(
     made.unwrap_or(std::ptr::null_mut())
 }
 
-/// Check the arguments and read the model.
+/// Check the arguments and read the model and its linearization states.
 ///
 /// # Safety
 /// `guid_p` and `res_p` are NULL or NUL-terminated.
@@ -101,7 +101,7 @@ unsafe fn instantiate(
     fmu_type: c_int,
     guid_p: FmiString,
     res_p: FmiString,
-) -> Result<(crate::model::Model, String), String> {
+) -> Result<(crate::model::Model, String, crate::linearize::StateLayout), String> {
     let fail = |m: String| format!("instance '{name}': {m}");
     match fmu_type {
         CO_SIMULATION => {}
@@ -112,7 +112,8 @@ unsafe fn instantiate(
     let given = unsafe { text(guid_p, "fmuGUID") }.map_err(fail)?;
     // SAFETY: per this function's contract.
     let res = unsafe { text(res_p, "fmuResourceLocation") }.map_err(fail)?;
-    let file = file_uri_to_path(&res).map_err(fail)?.join("model.xml");
+    let dir = file_uri_to_path(&res).map_err(fail)?;
+    let file = dir.join("model.xml");
     let model_text =
         std::fs::read_to_string(&file).map_err(|e| fail(format!("cannot read {}: {e}", file.display())))?;
     let own = guid(&model_text);
@@ -121,7 +122,8 @@ unsafe fn instantiate(
     }
     let model = crate::model::parse::load_str(&model_text, &file.display().to_string())
         .map_err(|e| fail(format!("invalid model: {e}")))?;
-    Ok((model, own))
+    let layout = super::pack::read_layout(&dir, &own).map_err(|e| fail(format!("no state layout: {e}")))?;
+    Ok((model, own, layout))
 }
 
 /// fmi2FreeInstance (2.1.5): release the instance and the FMU states it still holds

@@ -8,18 +8,24 @@ use super::state_machine::State;
 use super::types::Status;
 use super::variables::{Target, Variable, variables};
 use crate::dae::{DEFAULT_MAX_STEPS, SimOptions, SimState, Simulator};
-use crate::linearize::{Linearization, Selection, linearize, selection_by_name, state_values};
+use crate::linearize::{Linearization, Selection, StateLayout, linearize, selection_by_name, state_values};
 use crate::model::Model;
 
 /// What the host chose: parameter and input values, input slopes, experiment, solver
 /// settings.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Config {
+    /// Parameter values (model order).
     pub params: Vec<f64>,
+    /// Input values (model order).
     pub inputs: Vec<f64>,
+    /// Input slopes (fmi2SetRealInputDerivatives).
     pub slopes: Vec<f64>,
+    /// Integration tolerance.
     pub tol: f64,
+    /// Start time.
     pub start: f64,
+    /// Stop time, if the host gave one.
     pub stop: Option<f64>,
     /// `solver.maxSteps`: most integrator step attempts per fmi2DoStep (at least 1).
     pub max_steps: usize,
@@ -27,10 +33,14 @@ pub struct Config {
 
 /// The engine, with the configuration it was built from.
 pub struct Built {
+    /// The engine.
     pub sim: Simulator,
+    /// The parameter values it was built with.
     pub params: Vec<f64>,
+    /// The tolerance it was built with.
     pub tol: f64,
-    /// The linearization states of modelDescription.xml, rebuilt on this engine's system.
+    /// The linearization states of modelDescription.xml (the instance's [`StateLayout`]),
+    /// rebuilt on this engine's system.
     pub sel: Result<Selection, String>,
     /// The last linearization and the engine state it belongs to (cache).
     pub lin: Option<(SimState, Linearization)>,
@@ -38,6 +48,7 @@ pub struct Built {
 
 /// Outcome of fmi2DoStep once its arguments are valid.
 pub enum Step {
+    /// The step reached its end.
     Done,
     /// The engine stopped early (fmi2Discard), with its message.
     Failed(String),
@@ -45,13 +56,19 @@ pub enum Step {
 
 /// An FMU instance (the fmi2Component).
 pub struct Instance {
+    /// The host's logger and the logging settings.
     pub log: Logger,
+    /// Where the instance is in the FMI state machine.
     pub state: State,
     /// GUID of the model text: identifies whose FMU states this instance accepts.
     pub guid: String,
     base: Model,
+    /// The linearization states the FMU was packed with.
+    layout: StateLayout,
     vars: Vec<Variable>,
+    /// The values and experiment the host chose.
     pub config: Config,
+    /// The engine, once built.
     pub built: Option<Built>,
     /// Values changed since the engine was built (rebuild before use).
     pub dirty: bool,
@@ -62,9 +79,11 @@ pub struct Instance {
 }
 
 impl Instance {
-    /// A fresh instance (state Instantiated) of a parsed model.
-    pub fn new(base: Model, guid: String, log: Logger) -> Instance {
-        let vars = variables(&base);
+    /// A fresh instance (state Instantiated) of a parsed model whose FMU exposes the
+    /// linearization states `layout` (read from its resources, see
+    /// [`super::pack::read_layout`]).
+    pub fn new(base: Model, guid: String, layout: StateLayout, log: Logger) -> Instance {
+        let vars = variables(&base, &layout);
         let config = Self::default_config(&base);
         let last_time = config.start;
         Instance {
@@ -72,6 +91,7 @@ impl Instance {
             state: State::Instantiated,
             guid,
             base,
+            layout,
             vars,
             config,
             built: None,
@@ -165,18 +185,7 @@ impl Instance {
                 sim.set_input_derivative(k, s);
             }
         }
-        let names: Vec<String> =
-            self.vars.iter().filter(|v| matches!(v.target, Target::State(_))).map(|v| v.name.clone()).collect();
-        // Velocity states W_j, in j order: der(S_k) variables that are states, and the others.
-        let mut w: Vec<(usize, String)> = self
-            .vars
-            .iter()
-            .filter(|v| matches!(v.target, Target::StateDerivative(_) | Target::Velocity(_)))
-            .filter_map(|v| v.known.map(|c| (c - names.len(), v.name.clone())))
-            .collect();
-        w.sort();
-        let w_names: Vec<String> = w.into_iter().map(|(_, n)| n).collect();
-        let sel = selection_by_name(sim.system(), &names, &w_names);
+        let sel = selection_by_name(sim.system(), &self.layout);
         Ok(Built { sim, params: cfg.params.clone(), tol: cfg.tol, sel, lin: None })
     }
 

@@ -3,7 +3,6 @@
 //! nothing itself.
 
 pub mod bundle;
-pub mod dependencies;
 pub mod exports_common;
 pub mod exports_cs;
 pub mod exports_me;

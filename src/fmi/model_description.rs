@@ -1,28 +1,33 @@
 //! `modelDescription.xml` of a model's FMI 2.0 Co-Simulation FMU.
 //!
 //! The variables and their value references come from [`super::variables`] (shared with
-//! the C API). Dependencies in `<ModelStructure>` are structural (see
-//! [`super::dependencies`]): at communication points the knowns are the states S, W and
-//! the inputs, and each unknown lists only those of its own mechanism (connected
-//! component) that it can depend on. In Initialization Mode (`<InitialUnknowns>`) the
-//! knowns are also the parameters (`initial="exact"`): setting one re-evaluates the whole
-//! model, so every unknown depends on every parameter, and with
-//! `<analysis static="true"/>` the equilibrium positions depend on every input a force
-//! uses.
+//! the C API). `<ModelStructure>` writes the dependencies of
+//! [`crate::linearize::structure`], mapping its indices (states as columns of A, inputs,
+//! parameters) to FMI variable indices.
 
 use crate::model::units::{self, BASE_NAMES};
 use std::collections::BTreeSet;
 use std::fmt::Write as _;
 
-use super::dependencies::{Dependencies, Structure};
 use super::guid::{ENGINE_VERSION, guid, model_identifier};
 use super::variables::{Causality, Target, Variable, variables};
+use crate::linearize::structure::{Dependencies, ModelStructure};
+use crate::linearize::{FmuLinearization, StateLayout, for_fmu};
 use crate::model::Model;
 
-/// The modelDescription.xml of the FMU of `model`, whose file text is `model_text` (it
-/// determines the GUID, see [`guid`]).
+/// The modelDescription.xml that `mbfmu pack` writes for `model`, whose file text is
+/// `model_text`: its linearization decided by [`for_fmu`] (an engine run), then
+/// [`describe`].
 pub fn write(model: &Model, model_text: &str) -> String {
-    let vars = variables(model);
+    let FmuLinearization { layout, structure } = for_fmu(model);
+    describe(model, model_text, &layout, &structure)
+}
+
+/// The modelDescription.xml of the FMU of `model`, whose file text is `model_text` (it
+/// determines the GUID, see [`guid`]), with the linearization states `layout` and the
+/// dependencies `structure` (of the same selection, see [`for_fmu`]).
+pub fn describe(model: &Model, model_text: &str, layout: &StateLayout, structure: &ModelStructure) -> String {
+    let vars = variables(model, layout);
     let mut x = String::new();
     x.push_str("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
     x.push_str("<fmiModelDescription\n");
@@ -59,7 +64,7 @@ pub fn write(model: &Model, model_text: &str) -> String {
     }
     x.push_str("  </ModelVariables>\n");
 
-    write_structure(&mut x, model, &vars);
+    write_structure(&mut x, model, &vars, structure);
     x.push_str("</fmiModelDescription>\n");
     x
 }
@@ -208,119 +213,69 @@ fn unknown(x: &mut String, index: usize, deps: &BTreeSet<usize>) {
     );
 }
 
-fn write_structure(x: &mut String, model: &Model, vars: &[Variable]) {
-    // FMI index (1-based ModelVariables position) of each parameter, input and state.
-    let mut param_index = Vec::new();
+fn write_structure(x: &mut String, model: &Model, vars: &[Variable], st: &ModelStructure) {
+    // FMI index (1-based ModelVariables position) of each parameter, input and state
+    // (column of A).
+    let mut param_index = vec![0; model.parameters.len()];
     let mut input_index = vec![0; model.inputs.len()];
-    let (mut s_index, mut w_index) = (Vec::new(), Vec::new());
-    let mut state_index: BTreeSet<usize> = BTreeSet::new();
+    let mut state_index = vec![0; vars.iter().filter(|v| v.known.is_some()).count()];
     for (k, v) in vars.iter().enumerate() {
         match v.target {
-            Target::Parameter(_) => param_index.push(k + 1),
+            Target::Parameter(p) => param_index[p] = k + 1,
             Target::Input(i) => input_index[i] = k + 1,
-            Target::State(_) => s_index.push(k + 1),
-            Target::StateDerivative(_) if v.known.is_some() => w_index.push(k + 1),
             _ => {}
         }
-        if v.known.is_some() {
-            state_index.insert(k + 1);
+        if let Some(c) = v.known {
+            state_index[c] = k + 1;
         }
     }
-    let structure = Structure::of(model);
-    let global = structure.is_global();
-    let inputs_fmi = |d: &Dependencies| -> BTreeSet<usize> {
-        d.inputs.iter().filter_map(|i| input_index.get(*i).copied()).collect()
+    let fmi = |d: &Dependencies| -> BTreeSet<usize> {
+        let states = d.states.iter().map(|&c| state_index[c]);
+        states.chain(d.inputs.iter().map(|&i| input_index[i])).collect()
     };
-    // FMI indices of a dependency set: S_k and W_k (paired without non-holonomic
-    // constraints) and inputs; in global mode every state.
-    let to_fmi = |d: &Dependencies| -> BTreeSet<usize> {
-        let mut out = inputs_fmi(d);
-        if global {
-            out.extend(&state_index);
-        } else {
-            out.extend(d.states.iter().flat_map(|&k| [s_index.get(k), w_index.get(k)]).flatten().copied());
-        }
-        out
-    };
-    let all_forces = Dependencies { states: (0..s_index.len()).collect(), inputs: structure.force_inputs().clone() };
-    let mut unknowns = Vec::new(); // (index, dependencies at communication points)
+    let none = Dependencies::default();
+    let mut unknowns: Vec<(usize, &Dependencies)> = Vec::new(); // (index, at communication points)
     let mut derivatives = Vec::new();
     for (k, v) in vars.iter().enumerate() {
-        match v.target {
-            Target::Output(o) => {
-                let e = &model.outputs[o].function;
-                let d = structure.output(e);
-                let mut f = inputs_fmi(&d);
-                if global {
-                    let dd = crate::model::expr::deps(e);
-                    let user = !(dd.variables.is_empty() && dd.diffs.is_empty() && dd.diff_dots.is_empty());
-                    if !dd.markers.is_empty() || !dd.loads.is_empty() || user {
-                        f.extend(&state_index);
-                    }
-                } else {
-                    f = to_fmi(&d);
-                }
-                unknowns.push((k + 1, f));
-            }
-            // der(S) is the velocity state W itself (Eq. 34g) where it is one; otherwise
-            // ṡ(q, u) depends on the positions and velocities, i.e. on every state.
-            Target::StateDerivative(_) => {
-                let d: BTreeSet<usize> =
-                    if v.known.is_some() { [k + 1].into() } else { to_fmi(&Dependencies::default()) };
-                derivatives.push((k + 1, d.clone()));
-                unknowns.push((k + 1, d));
-            }
-            // der(W) = Ẇ: from the equations of motion of its component.
-            Target::VelocityDerivative(i) => {
-                let d = if global { to_fmi(&all_forces) } else { to_fmi(&structure.acceleration(i)) };
-                derivatives.push((k + 1, d.clone()));
-                unknowns.push((k + 1, d));
-            }
-            // der(X): the user rows read anything (global mode).
-            Target::DiffDerivative(_) => {
-                let d = to_fmi(&all_forces);
-                derivatives.push((k + 1, d.clone()));
-                unknowns.push((k + 1, d));
-            }
-            Target::State(_) | Target::Velocity(_) | Target::Diff(_) => unknowns.push((k + 1, BTreeSet::new())),
-            _ => {}
+        let d = match v.target {
+            Target::Output(o) => &st.outputs[o],
+            Target::StateDerivative(i) => &st.position_rates[i],
+            Target::VelocityDerivative(j) => &st.velocity_rates[j],
+            Target::DiffDerivative(i) => &st.diff_rates[i],
+            Target::State(_) | Target::Velocity(_) | Target::Diff(_) => &none,
+            _ => continue,
+        };
+        if matches!(v.target, Target::StateDerivative(_) | Target::VelocityDerivative(_) | Target::DiffDerivative(_)) {
+            derivatives.push((k + 1, d));
         }
+        unknowns.push((k + 1, d));
     }
     if unknowns.is_empty() {
         x.push_str("  <ModelStructure/>\n");
         return;
     }
-    let static_inputs: BTreeSet<usize> = if model.static_analysis {
-        structure.force_inputs().iter().filter_map(|i| input_index.get(*i).copied()).collect()
-    } else {
-        BTreeSet::new()
-    };
     x.push_str("  <ModelStructure>\n");
-    let outputs: Vec<&(usize, BTreeSet<usize>)> =
+    let outputs: Vec<&(usize, &Dependencies)> =
         unknowns.iter().filter(|(i, _)| matches!(vars[i - 1].target, Target::Output(_))).collect();
     if !outputs.is_empty() {
         x.push_str("    <Outputs>\n");
         for (index, d) in outputs {
-            unknown(x, *index, d);
+            unknown(x, *index, &fmi(d));
         }
         x.push_str("    </Outputs>\n");
     }
     if !derivatives.is_empty() {
         x.push_str("    <Derivatives>\n");
         for (index, d) in &derivatives {
-            unknown(x, *index, d);
+            unknown(x, *index, &fmi(d));
         }
         x.push_str("    </Derivatives>\n");
     }
-    // Initialization Mode: knowns are parameters (initial="exact") and inputs; states are
-    // computed from them (assembly), so every unknown depends on every parameter.
     x.push_str("    <InitialUnknowns>\n");
-    unknowns.sort_by_key(|(i, _)| *i);
     for (index, d) in &unknowns {
-        let mut init: BTreeSet<usize> = param_index.iter().copied().collect();
-        init.extend(d.iter().filter(|i| !state_index.contains(i)));
-        init.extend(&static_inputs);
-        unknown(x, *index, &init);
+        let init = st.initial(d);
+        let params = init.parameters.iter().map(|&p| param_index[p]);
+        unknown(x, *index, &params.chain(init.inputs.iter().map(|&i| input_index[i])).collect());
     }
     x.push_str("    </InitialUnknowns>\n  </ModelStructure>\n");
 }
@@ -366,11 +321,8 @@ mod tests {
     #[test]
     fn dependencies_follow_inputs_through_forces_and_accelerations() {
         let model = crate::model::load_str(INPUTS, "inputs.xml").unwrap_or_else(|e| panic!("{e}"));
-        let d: Vec<Vec<usize>> = model
-            .outputs
-            .iter()
-            .map(|o| Structure::of(&model).output(&o.function).inputs.into_iter().collect())
-            .collect();
+        let structure = for_fmu(&model).structure;
+        let d: Vec<Vec<usize>> = structure.outputs.iter().map(|o| o.inputs.iter().copied().collect()).collect();
         assert_eq!(d, [vec![], vec![2], vec![0, 1], vec![0, 1], vec![0, 2]]);
         let xml = write(&model, INPUTS);
         // Indices: m 1, k 2, u 3, v 4, w 5, pos 6, direct 7, acc 8, reaction 9, force 10.

@@ -4,7 +4,14 @@
 //! modelDescription.xml
 //! binaries/<platform>/<modelIdentifier>.<ext>   a copy of this crate's cdylib
 //! resources/model.xml                           the model file, byte for byte
+//! resources/states.txt                          the linearization states (StateLayout)
 //! ```
+//!
+//! The linearization states are selected once, here (an engine run,
+//! [`crate::linearize::for_fmu`]); an instance reads them back with [`read_layout`]
+//! instead of selecting them again. When they cannot be selected the FMU is still packed,
+//! without states, and [`Packed::warnings`] says why (the engine's error then shows again,
+//! located, at fmi2EnterInitializationMode).
 //!
 //! The cdylib is found through the environment variable `MBFMU_LIB` (a file path), else
 //! inside the running executable (an installed `mbfmu`, see [`super::bundle`]), else next
@@ -18,7 +25,11 @@ use zip::write::SimpleFileOptions;
 
 use super::guid::{guid, model_identifier};
 use super::model_description;
+use crate::linearize::{FmuLinearization, StateLayout, for_fmu};
 use crate::model::{ModelError, load_str};
+
+/// The state layout's file in the FMU's resources directory.
+pub const LAYOUT_FILE: &str = "states.txt";
 
 /// FMI platform folder under `binaries/`.
 #[cfg(target_os = "macos")]
@@ -47,6 +58,7 @@ pub enum PackError {
     Io {
         /// What was being read or written.
         context: String,
+        /// The I/O error.
         source: std::io::Error,
     },
 }
@@ -63,6 +75,8 @@ pub struct Packed {
     pub model_identifier: String,
     /// The FMU's GUID.
     pub guid: String,
+    /// What the FMU lacks and why (no linearization states: the selection's error).
+    pub warnings: Vec<String>,
 }
 
 /// The files of an FMU, relative path and contents, in archive order.
@@ -146,13 +160,40 @@ fn contents(model_path: &Path) -> Result<Contents, PackError> {
     let model = load_str(text, &label)?;
     let id = model_identifier(&model.name);
     let lib = library()?;
-    let xml = model_description::write(&model, text);
+    let FmuLinearization { layout, structure } = for_fmu(&model);
+    let xml = model_description::describe(&model, text, &layout, &structure);
+    let guid = guid(text);
+    let warnings = layout
+        .missing
+        .iter()
+        .map(|why| format!("the FMU has no linearization states (fmi2GetDirectionalDerivative will fail): {why}"))
+        .collect();
     let files = vec![
         ("modelDescription.xml".to_string(), xml.into_bytes()),
         (format!("binaries/{PLATFORM}/{id}.{LIB_EXT}"), lib),
         ("resources/model.xml".to_string(), bytes.clone()),
+        (format!("resources/{LAYOUT_FILE}"), layout.to_text(&guid).into_bytes()),
     ];
-    Ok(Contents { packed: Packed { guid: guid(text), model_identifier: id }, files })
+    Ok(Contents { packed: Packed { guid, model_identifier: id, warnings }, files })
+}
+
+/// The state layout file of the model text `model_text` (as [`pack`] writes it into
+/// `resources/`), and the warning when the states cannot be selected. For hosts that
+/// build a resources directory themselves (tests); the engine runs on a stack of its own
+/// when the caller's is small (as in the exports).
+pub fn layout_file(model_text: &str, label: &str) -> Result<(Vec<u8>, Option<String>), ModelError> {
+    super::guard::with_stack(|| {
+        let layout = StateLayout::at_start(&load_str(model_text, label)?);
+        Ok((layout.to_text(&guid(model_text)).into_bytes(), layout.missing))
+    })
+}
+
+/// The state layout of the FMU whose resources directory is `resources` and whose model
+/// has the GUID `guid` (read at fmi2Instantiate; no engine run).
+pub fn read_layout(resources: &Path, guid: &str) -> Result<StateLayout, String> {
+    let file = resources.join(LAYOUT_FILE);
+    let text = std::fs::read_to_string(&file).map_err(|e| format!("cannot read {}: {e}", file.display()))?;
+    StateLayout::from_text(&text, guid).map_err(|e| format!("{}: {e}", file.display()))
 }
 
 /// Write the FMU of the model file `model_path` as the zip archive `out` (replacing it).

@@ -5,11 +5,14 @@
 //! `der(S,2)` / `der(W)`, then the differential states X, `der(X)` and the user variables
 //! V, numbered consecutively from 0 in model order; last the solver settings (the Integer
 //! parameter `solver.maxSteps`: a model name has no '.', so it cannot collide, and being
-//! last it shifts no other value reference). The packer writes them into
-//! modelDescription.xml and the C API resolves value references with them, so both
-//! always agree.
+//! last it shifts no other value reference). The linearization states are those of the
+//! [`StateLayout`] the packer decided and stored in the FMU; the packer writes the
+//! variables into modelDescription.xml and the C API resolves value references with them,
+//! so both always agree.
 
 use crate::dae::DEFAULT_MAX_STEPS;
+use crate::linearize::StateLayout;
+use crate::linearize::states::derivative_name;
 use crate::model::Model;
 use crate::model::units::per_second;
 
@@ -19,8 +22,11 @@ pub const MAX_STEPS_NAME: &str = "solver.maxSteps";
 /// FMI causality of a variable.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Causality {
+    /// A model parameter or a solver setting.
     Parameter,
+    /// A model input.
     Input,
+    /// A model output.
     Output,
     /// Linearization states and their derivatives.
     Local,
@@ -63,13 +69,19 @@ impl Target {
 /// One FMI scalar variable (Real, except `solver.maxSteps`: see [`Target::is_integer`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Variable {
+    /// FMI name.
     pub name: String,
+    /// FMI value reference (its index in [`variables`]).
     pub value_reference: u32,
+    /// FMI causality.
     pub causality: Causality,
+    /// What it denotes in the engine.
     pub target: Target,
     /// Start value (parameters and inputs; an Integer's is a whole number).
     pub start: Option<f64>,
+    /// Unit, if any.
     pub unit: Option<String>,
+    /// FMI description, if any.
     pub description: Option<String>,
     /// For a state derivative: the 1-based ModelVariables index of its state.
     pub derivative: Option<usize>,
@@ -79,31 +91,9 @@ pub struct Variable {
     pub unknown: Option<usize>,
 }
 
-/// The linearization states an FMU exposes: position states S and velocity states W
-/// (`w_of[j]`: the S index whose derivative W_j is, if any).
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct StateLayout {
-    pub s: Vec<String>,
-    pub w: Vec<String>,
-    pub w_of: Vec<Option<usize>>,
-    /// Units of S and W (from the coordinate: m, rad, m/s, rad/s; none for a general
-    /// expression).
-    pub s_units: Vec<Option<String>>,
-    pub w_units: Vec<Option<String>>,
-    /// What each S and W measures, frame stated (FMI variable descriptions).
-    pub s_about: Vec<String>,
-    pub w_about: Vec<String>,
-}
-
-impl StateLayout {
-    /// The velocity state that is Ṡ_k, if any.
-    pub fn w_for(&self, k: usize) -> Option<usize> {
-        self.w_of.iter().position(|o| *o == Some(k))
-    }
-}
-
-/// All FMI variables of a model, in ModelVariables order (index + 1 = FMI index).
-pub fn variables(model: &Model) -> Vec<Variable> {
+/// All FMI variables of a model whose FMU exposes the linearization states `lay`, in
+/// ModelVariables order (index + 1 = FMI index).
+pub fn variables(model: &Model, lay: &StateLayout) -> Vec<Variable> {
     let mut v = Vec::new();
     for (k, p) in model.parameters.iter().enumerate() {
         v.push(Variable {
@@ -147,8 +137,7 @@ pub fn variables(model: &Model) -> Vec<Variable> {
             unknown: None,
         });
     }
-    let lay = state_layout(model);
-    let (s0, s1) = (lay.s.len(), lay.w.len());
+    let (s0, s1) = (lay.positions.len(), lay.velocities.len());
     let var = |name: String, vr: usize, target: Target| Variable {
         name,
         value_reference: vr as u32,
@@ -162,44 +151,48 @@ pub fn variables(model: &Model) -> Vec<Variable> {
         unknown: None,
     };
     let first_s = v.len();
-    for (k, name) in lay.s.iter().enumerate() {
-        let mut x = var(name.clone(), v.len(), Target::State(k));
-        x.unit = lay.s_units[k].clone();
-        x.description = Some(lay.s_about[k].clone());
+    for (k, s) in lay.positions.iter().enumerate() {
+        let mut x = var(s.name.clone(), v.len(), Target::State(k));
+        x.unit = s.unit.clone();
+        x.description = Some(s.description.clone());
         x.known = Some(k);
         v.push(x);
     }
+    // der(S_k): the velocity state W_j = Ṡ_k where there is one (its name), else a derivative only.
     let first_sd = v.len();
-    for (k, name) in lay.s.iter().enumerate() {
-        let mut x = var(format!("der({name})"), v.len(), Target::StateDerivative(k));
-        x.unit = lay.s_units[k].as_deref().and_then(per_second);
+    for (k, s) in lay.positions.iter().enumerate() {
+        let w = lay.velocity_of_state(k);
+        let name = w.map_or_else(|| derivative_name(&s.name), |j| lay.velocities[j].name.clone());
+        let mut x = var(name, v.len(), Target::StateDerivative(k));
+        x.unit = s.unit.as_deref().and_then(per_second);
         x.derivative = Some(first_s + k + 1);
-        x.known = lay.w_for(k).map(|j| s0 + j);
+        x.known = w.map(|j| s0 + j);
         x.unknown = Some(k);
         v.push(x);
     }
     // 1-based index of each W_j's variable.
     let mut w_index = vec![0; s1];
     for (j, w) in w_index.iter_mut().enumerate() {
-        if let Some(k) = lay.w_of[j] {
+        if let Some(k) = lay.state_of_velocity(j) {
             *w = first_sd + k + 1;
         }
     }
-    for j in (0..s1).filter(|&j| lay.w_of[j].is_none()) {
-        let mut x = var(lay.w[j].clone(), v.len(), Target::Velocity(j));
-        x.unit = lay.w_units[j].clone();
-        x.description = Some(lay.w_about[j].clone());
+    for j in (0..s1).filter(|&j| lay.state_of_velocity(j).is_none()) {
+        let w = &lay.velocities[j];
+        let mut x = var(w.name.clone(), v.len(), Target::Velocity(j));
+        x.unit = w.unit.clone();
+        x.description = Some(w.description.clone());
         x.known = Some(s0 + j);
         w_index[j] = v.len() + 1;
         v.push(x);
     }
     for (j, &wi) in w_index.iter().enumerate() {
-        let name = match lay.w_of[j] {
-            Some(k) => format!("der({},2)", lay.s[k]),
-            None => format!("der({})", lay.w[j]),
+        let name = match lay.state_of_velocity(j) {
+            Some(k) => format!("der({},2)", lay.positions[k].name),
+            None => derivative_name(&lay.velocities[j].name),
         };
         let mut x = var(name, v.len(), Target::VelocityDerivative(j));
-        x.unit = lay.w_units[j].as_deref().and_then(per_second);
+        x.unit = lay.velocities[j].unit.as_deref().and_then(per_second);
         x.derivative = Some(wi);
         x.unknown = Some(s0 + j);
         v.push(x);
@@ -212,7 +205,7 @@ pub fn variables(model: &Model) -> Vec<Variable> {
         v.push(x);
     }
     for (k, d) in model.differentials.iter().enumerate() {
-        let mut x = var(format!("der({})", d.name), v.len(), Target::DiffDerivative(k));
+        let mut x = var(derivative_name(&d.name), v.len(), Target::DiffDerivative(k));
         x.derivative = Some(first_x + k + 1);
         x.unknown = Some(s0 + s1 + k);
         v.push(x);
@@ -239,18 +232,4 @@ pub fn variables(model: &Model) -> Vec<Variable> {
         unknown: None,
     });
     v
-}
-
-/// The linearization states the FMU exposes (selected from the assembled initial
-/// configuration); none when the model cannot be initialized or linearized.
-pub fn state_layout(model: &Model) -> StateLayout {
-    let Ok(sel) = crate::linearize::selection_at_start(model) else { return StateLayout::default() };
-    let s: Vec<String> = sel.states.iter().map(|x| x.name.clone()).collect();
-    let w: Vec<String> = sel.velocities.iter().map(|x| x.name()).collect();
-    let w_of = w.iter().map(|n| s.iter().position(|sn| format!("der({sn})") == *n)).collect();
-    let s_units = sel.states.iter().map(|x| x.unit()).collect();
-    let w_units = sel.velocities.iter().map(|x| x.unit()).collect();
-    let s_about = sel.states.iter().map(|x| x.description()).collect();
-    let w_about = sel.velocities.iter().map(|x| x.description()).collect();
-    StateLayout { s, w, w_of, s_units, w_units, s_about, w_about }
 }

@@ -26,6 +26,7 @@ pub enum Candidates {
 /// One position-level candidate.
 #[derive(Clone, Debug)]
 pub struct Candidate {
+    /// The function that would be the state.
     pub state: StateFn,
     /// Its tier: 0 user states, then 1 + the joint coordinate's [`CoordRank`].
     pub tier: usize,

@@ -8,13 +8,11 @@
 
 use super::candidates::{Candidate, Candidates, TIERS, position_candidates};
 use super::jets::{PositionFn, jets};
-use super::select_velocity::{derivative_states, select_velocities};
+use super::select_velocity::{VelOrigin, derivative_states, select_velocities};
 use super::states::{StateFn, VelState, internal_state};
 use super::tiers::{CandidateRow, TierError, choose_in_tiers, constraint_rows, gradient_row};
+use super::tolerances::RANK_TOL;
 use crate::mechanics::System;
-
-/// A pivot below this fraction of the largest pivot (at least 1) counts as zero (rank decision).
-pub const RANK_TOL: f64 = 1e-9;
 
 /// The chosen states and what was dropped.
 #[derive(Clone, Debug)]
@@ -28,6 +26,40 @@ pub struct Selection {
     pub dropped: Vec<String>,
     /// Number of independent constraint equations (m minus redundant ones).
     pub rank: usize,
+    /// For each W_j, the k with W_j = Ṡ_k (see [`Selection::state_of_velocity`]).
+    velocity_of: Vec<Option<usize>>,
+}
+
+impl Selection {
+    /// A selection of `states` and `velocities` where W_j = Ṡ_k for `velocity_of[j] ==
+    /// Some(k)` (one entry per velocity state; `velocities[j]` is then the derivative of
+    /// `states[k]`).
+    pub(crate) fn new(
+        states: Vec<StateFn>,
+        velocities: Vec<VelState>,
+        velocity_of: Vec<Option<usize>>,
+        dropped: Vec<String>,
+        rank: usize,
+    ) -> Selection {
+        debug_assert_eq!(velocity_of.len(), velocities.len());
+        debug_assert!(velocity_of.iter().zip(&velocities).all(|(k, w)| match k {
+            Some(k) => matches!(w, VelState::Derivative(s) if *s == states[*k]),
+            None => true,
+        }));
+        Selection { states, velocities, dropped, rank, velocity_of }
+    }
+
+    /// The index k of the position state S_k whose time derivative the velocity state W_j
+    /// is (Eq. 34g–h: W_j = Ṡ_k); None for a user `<velocity>` or a velocity state that is
+    /// not the derivative of a selected position state (non-holonomic models).
+    pub fn state_of_velocity(&self, j: usize) -> Option<usize> {
+        self.velocity_of.get(j).copied().flatten()
+    }
+
+    /// The index j of the velocity state W_j = Ṡ_k, if S_k has one.
+    pub fn velocity_of_state(&self, k: usize) -> Option<usize> {
+        self.velocity_of.iter().position(|o| *o == Some(k))
+    }
 }
 
 /// Select s = n − rank(C_q) states at (q, t), favouring the model's user states, then
@@ -75,17 +107,33 @@ pub fn select_states_among(
             picked[c] = choice.chosen[t].get(k).copied().unwrap_or(false);
         }
     }
-    let mut states: Vec<StateFn> = (0..cands.len()).filter(|&c| picked[c]).map(|c| cands[c].state.clone()).collect();
+    // S: the chosen candidates, then the free coordinates; the S index of each.
+    let mut states: Vec<StateFn> = Vec::new();
+    let mut of_candidate = vec![None; cands.len()];
+    for c in (0..cands.len()).filter(|&c| picked[c]) {
+        of_candidate[c] = Some(states.len());
+        states.push(cands[c].state.clone());
+    }
+    let first_free = states.len();
     states.extend(choice.free.iter().map(|&c| internal_state(sys, c)));
+    let of_coordinate = |c: usize| choice.free.iter().position(|&f| f == c).map(|i| first_free + i);
     let mut dropped: Vec<String> =
         (0..cands.len()).filter(|&c| !picked[c] && cands[c].user).map(|c| cands[c].state.name.clone()).collect();
-    let velocities = if sys.mn == 0 {
-        derivative_states(&states)
-    } else {
-        // B and the candidates' u-gradients do not depend on u (linear in velocities).
-        let (v, d) = select_velocities(sys, q, &vec![0.0; n], t, inputs, &cands)?;
-        dropped.extend(d.into_iter().filter(|d| !states.iter().any(|s| format!("der({})", s.name) == *d)));
-        v
+    if sys.mn == 0 {
+        let velocity_of = (0..states.len()).map(Some).collect();
+        return Ok(Selection::new(states.clone(), derivative_states(&states), velocity_of, dropped, choice.rank));
+    }
+    // B and the candidates' u-gradients do not depend on u (linear in velocities).
+    let v = select_velocities(sys, q, &vec![0.0; n], t, inputs, &cands)?;
+    // The S index of the position function a velocity candidate is the derivative of.
+    let state_of = |o: VelOrigin| match o {
+        VelOrigin::User(_) => None,
+        VelOrigin::Candidate(c) => of_candidate[c],
+        VelOrigin::Coordinate(c) => of_coordinate(c),
     };
-    Ok(Selection { states, velocities, dropped, rank: choice.rank })
+    // A user state that is a position state stays one even without its derivative.
+    dropped.extend(v.dropped.iter().filter(|(_, o)| state_of(*o).is_none()).map(|(w, _)| w.name()));
+    let velocity_of = v.chosen.iter().map(|(_, o)| state_of(*o)).collect();
+    let velocities = v.chosen.into_iter().map(|(w, _)| w).collect();
+    Ok(Selection::new(states, velocities, velocity_of, dropped, choice.rank))
 }

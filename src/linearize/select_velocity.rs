@@ -8,9 +8,9 @@
 
 use super::candidates::{Candidate, TIERS};
 use super::jets::jets;
-use super::select::RANK_TOL;
 use super::states::{StateFn, VelState, internal_state, user_velocities};
 use super::tiers::{CandidateRow, TierError, choose_in_tiers, constraint_rows, gradient_row};
+use super::tolerances::RANK_TOL;
 use crate::dae::equations::nonholonomic_b;
 use crate::mechanics::System;
 use crate::mechanics::body::{NQ, row_times_t};
@@ -20,9 +20,28 @@ fn sparse(row: &[f64]) -> Vec<(usize, f64)> {
     row.iter().enumerate().filter(|(_, v)| **v != 0.0).map(|(c, &v)| (c, v)).collect()
 }
 
+/// Where a velocity candidate comes from (the index relation to the position level).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VelOrigin {
+    /// The user's `<velocity>` k (its index among [`user_velocities`]).
+    User(usize),
+    /// The time derivative of position candidate i (its index in the `pos` argument).
+    Candidate(usize),
+    /// The time derivative q̇_c of coordinate c (a body coordinate completing the set).
+    Coordinate(usize),
+}
+
+/// The outcome of [`select_velocities`].
+#[derive(Clone, Debug, Default)]
+pub struct VelocityChoice {
+    /// The velocity states W, in order, with their origins.
+    pub chosen: Vec<(VelState, VelOrigin)>,
+    /// The user's candidates (`<velocity>`s and derivatives of user states) not chosen.
+    pub dropped: Vec<(VelState, VelOrigin)>,
+}
+
 /// Choose the velocity states W at (q, u, t) among the user's `<velocity>` expressions
-/// and the derivatives of the position candidates `pos`; also returns the names of
-/// dropped user candidates.
+/// and the derivatives of the position candidates `pos`.
 pub fn select_velocities(
     sys: &System,
     q: &[f64],
@@ -30,21 +49,21 @@ pub fn select_velocities(
     t: f64,
     ext: &[f64],
     pos: &[Candidate],
-) -> Result<(Vec<VelState>, Vec<String>), String> {
+) -> Result<VelocityChoice, String> {
     let n = sys.n();
     let zeros = vec![0.0; n];
-    // (candidate, a user's) by tier, with their q̇-rows.
-    let mut cands: Vec<Vec<(VelState, bool)>> = vec![Vec::new(); TIERS + 1];
+    // (candidate, its origin, a user's) by tier, with their q̇-rows.
+    let mut cands: Vec<Vec<(VelState, VelOrigin, bool)>> = vec![Vec::new(); TIERS + 1];
     let mut tiers: Vec<Vec<CandidateRow>> = vec![Vec::new(); TIERS + 1];
-    let mut push = |tier: usize, c: VelState, user: bool, row: CandidateRow| {
+    let mut push = |tier: usize, c: VelState, origin: VelOrigin, user: bool, row: CandidateRow| {
         if row.entries.iter().any(|(_, v)| !v.is_finite()) {
             return Err(format!("velocity candidate '{}' has no finite derivative here", c.name()));
         }
         tiers[tier].push(row);
-        cands[tier].push((c, user));
+        cands[tier].push((c, origin, user));
         Ok(())
     };
-    for v in user_velocities(sys) {
+    for (k, v) in user_velocities(sys).into_iter().enumerate() {
         let j = &jets(sys, &v, q, u, &zeros, t, ext)[0];
         let nql = NQ * v.bodies.len();
         let mut row = vec![0.0; n];
@@ -52,12 +71,13 @@ pub fn select_velocities(
             row[NQ * v.bodies[a / NQ] + a % NQ] = j.dg[nql + a];
         }
         row_times_t(q, &mut row);
-        push(0, VelState::User(v), true, CandidateRow { entries: sparse(&row) })?;
+        push(0, VelState::User(v), VelOrigin::User(k), true, CandidateRow { entries: sparse(&row) })?;
     }
-    for Candidate { state: s, tier, user } in pos {
+    for (i, Candidate { state: s, tier, user }) in pos.iter().enumerate() {
         // d/dt s(q) = s_q q̇: the position gradient is the q̇-row.
         let j = &jets(sys, s, q, u, &zeros, t, ext)[0];
-        push(tier + 1, VelState::Derivative(s.clone()), *user, gradient_row(&s.bodies, &j.dg))?;
+        let row = gradient_row(&s.bodies, &j.dg);
+        push(tier + 1, VelState::Derivative(s.clone()), VelOrigin::Candidate(i), *user, row)?;
     }
     let (mut fixed, mut nf) = constraint_rows(sys, q, t, ext);
     let (b, _) = nonholonomic_b(sys, q, u, t, ext);
@@ -76,19 +96,19 @@ pub fn select_velocities(
         TierError::NotFinite(e) => format!("the velocity constraint Jacobian is not finite here ({e})"),
         TierError::Dependent => "the non-holonomic constraints are not independent of the others".into(),
     })?;
-    let mut out: Vec<VelState> = Vec::new();
-    let mut dropped = Vec::new();
+    let mut out = VelocityChoice::default();
     for (tier, cs) in cands.into_iter().enumerate() {
-        for (k, (c, user)) in cs.into_iter().enumerate() {
+        for (k, (c, origin, user)) in cs.into_iter().enumerate() {
             if choice.chosen[tier].get(k).copied().unwrap_or(false) {
-                out.push(c);
+                out.chosen.push((c, origin));
             } else if user {
-                dropped.push(c.name());
+                out.dropped.push((c, origin));
             }
         }
     }
-    out.extend(choice.free.iter().map(|&c| VelState::Derivative(internal_state(sys, c))));
-    Ok((out, dropped))
+    out.chosen
+        .extend(choice.free.iter().map(|&c| (VelState::Derivative(internal_state(sys, c)), VelOrigin::Coordinate(c))));
+    Ok(out)
 }
 
 /// W = Ṡ for every position state (no non-holonomic constraints: s1 = s0).

@@ -10,20 +10,37 @@ use crate::mechanics::System;
 use crate::mechanics::local::LocalCtx;
 use crate::model::expr::{Expr, deps};
 
+/// The name of the time derivative of the quantity named `name`: `der(name)`, the FMI
+/// convention; the one place that writes it ([`derivative_of_name`] reads it).
+pub fn derivative_name(name: &str) -> String {
+    format!("der({name})")
+}
+
+/// The `name` of [`derivative_name`]`(name)`, if `der` is one.
+pub fn derivative_of_name(der: &str) -> Option<&str> {
+    der.strip_prefix("der(")?.strip_suffix(')')
+}
+
 /// A velocity-level state W (seed Eq. 34h): the time derivative of a position-level
 /// candidate, or a user `<velocity>` expression w(q, u, t).
 #[derive(Clone, Debug, PartialEq)]
 pub enum VelState {
+    /// W = ṡ(q) of a position-level function s.
     Derivative(StateFn),
+    /// A user `<velocity>` expression.
     User(UserVelocity),
 }
 
 /// A `<linearization><velocity>` expression.
 #[derive(Clone, Debug, PartialEq)]
 pub struct UserVelocity {
+    /// Its name.
     pub name: String,
+    /// The expression w(q, u, t).
     pub f: Expr,
+    /// Its angle-unwrapping slot base.
     pub abase: usize,
+    /// The bodies it reads (sorted, once each).
     pub bodies: Vec<usize>,
 }
 
@@ -44,9 +61,13 @@ impl PositionFn for UserVelocity {
 
 /// w, ẇ of a velocity state with gradients over (local q, local u, local u̇, t).
 pub struct VelJet {
+    /// w.
     pub w: f64,
+    /// ẇ.
     pub wd: f64,
+    /// Gradient of w.
     pub dw: Vec<f64>,
+    /// Gradient of ẇ.
     pub dwd: Vec<f64>,
 }
 
@@ -54,7 +75,7 @@ impl VelState {
     /// Its name: `der(S)` for a derivative, else the user's name.
     pub fn name(&self) -> String {
         match self {
-            VelState::Derivative(s) => format!("der({})", s.name),
+            VelState::Derivative(s) => derivative_name(&s.name),
             VelState::User(u) => u.name.clone(),
         }
     }
@@ -105,21 +126,44 @@ pub fn user_velocities(sys: &System) -> Vec<UserVelocity> {
 /// What a state measures.
 #[derive(Clone, Debug, PartialEq)]
 pub enum StateKind {
-    /// A `<linearization><state>` expression with its angle-unwrapping slot base.
-    User { f: Expr, abase: usize },
-    /// A joint's free coordinate (`sys.joint_coords`): what it measures, frame stated.
-    Joint { f: Expr, abase: usize, about: String },
+    /// A `<linearization><state>` expression.
+    User {
+        /// The expression s(q, t).
+        f: Expr,
+        /// Its angle-unwrapping slot base.
+        abase: usize,
+    },
+    /// A joint's free coordinate (`sys.joint_coords`).
+    Joint {
+        /// The coordinate as an expression.
+        f: Expr,
+        /// Its angle-unwrapping slot base.
+        abase: usize,
+        /// What it measures, frame stated.
+        about: String,
+    },
     /// CM coordinate k (x, y, z) of a body, ground frame.
-    Position { k: usize },
+    Position {
+        /// 0, 1, 2: x, y, z.
+        k: usize,
+    },
     /// 3-1-3 angle k (ψ, θ, φ) of a body relative to the fixed frame `r0`.
-    Angle { k: usize, r0: [[f64; 3]; 3] },
+    Angle {
+        /// 0, 1, 2: ψ, θ, φ.
+        k: usize,
+        /// The body's reference frame, fixed at selection time.
+        r0: [[f64; 3]; 3],
+    },
 }
 
 /// One linearization state.
 #[derive(Clone, Debug, PartialEq)]
 pub struct StateFn {
+    /// Its name (a user state's, `joint.angle`, `body.x` ...).
     pub name: String,
+    /// What it measures.
     pub kind: StateKind,
+    /// The bodies it reads (sorted, once each).
     pub bodies: Vec<usize>,
 }
 

@@ -21,6 +21,7 @@ pub const D_SMALL: f64 = 1e-3;
 /// One candidate row: its gradient over the n coordinates (sparse).
 #[derive(Clone, Debug, Default)]
 pub struct CandidateRow {
+    /// (coordinate, ∂s/∂q) pairs.
     pub entries: Vec<(usize, f64)>,
 }
 
@@ -60,6 +61,7 @@ pub enum TierError {
 /// The outcome: per tier, which candidates were chosen; the coordinates left free.
 #[derive(Clone, Debug)]
 pub struct TierChoice {
+    /// Per tier, per candidate: whether it was chosen.
     pub chosen: Vec<Vec<bool>>,
     /// Coordinates (columns of F) without a pivot after the last tier.
     pub free: Vec<usize>,

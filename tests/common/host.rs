@@ -18,9 +18,10 @@ pub const CALLBACKS: CallbackFunctions = CallbackFunctions {
     component_environment: std::ptr::null_mut(),
 };
 
-/// `<tmp>/mbfmu <tag> 100% <pid> <guid>/resources/model.xml` holding `text`: the directory
-/// (remove it when done, if wanted) and the resource location's `file://` URI, with the
-/// space and the `%` of the path escaped as a host must.
+/// `<tmp>/mbfmu <tag> 100% <pid> <guid>/resources/model.xml` holding `text`, with the state
+/// layout `mbfmu pack` writes beside it (when the text is a model): the directory (remove
+/// it when done, if wanted) and the resource location's `file://` URI, with the space and
+/// the `%` of the path escaped as a host must.
 pub fn resources(text: &str, tag: &str) -> (PathBuf, CString) {
     let id: String = mbfmu::fmi::guid::guid(text).chars().filter(char::is_ascii_hexdigit).collect();
     let top = std::env::temp_dir().join(format!("mbfmu {tag} 100% {} {id}", std::process::id()));
@@ -30,6 +31,12 @@ pub fn resources(text: &str, tag: &str) -> (PathBuf, CString) {
     if !file.exists() {
         // Write then rename: tests running in parallel never read a half-written file.
         let tmp = dir.join(format!("model.{:?}.tmp", std::thread::current().id()));
+        // The layout first: model.xml present means both are.
+        if let Ok((layout, _)) = mbfmu::fmi::pack::layout_file(text, "model.xml") {
+            std::fs::write(&tmp, layout).unwrap_or_else(|e| panic!("{}: {e}", tmp.display()));
+            let to = dir.join(mbfmu::fmi::pack::LAYOUT_FILE);
+            std::fs::rename(&tmp, &to).unwrap_or_else(|e| panic!("{}: {e}", to.display()));
+        }
         std::fs::write(&tmp, text).unwrap_or_else(|e| panic!("{}: {e}", tmp.display()));
         std::fs::rename(&tmp, &file).unwrap_or_else(|e| panic!("{}: {e}", file.display()));
     }

@@ -56,7 +56,7 @@ def test_packed_fmu_validates(model: Path, tmp_path: Path):
     identifier = md.coSimulation.modelIdentifier
     with zipfile.ZipFile(fmu) as z:
         assert sorted(z.namelist()) == sorted(
-            ["modelDescription.xml", f"binaries/linux64/{identifier}.so", "resources/model.xml"]
+            ["modelDescription.xml", f"binaries/linux64/{identifier}.so", "resources/model.xml", "resources/states.txt"]
         )
         assert z.read("resources/model.xml") == model.read_bytes()
 
