@@ -2,6 +2,7 @@
 //! initialization (assembly), and the integrator (Radau IIA on the stabilized system).
 
 mod assembly_moves;
+pub mod bytes;
 pub mod counts;
 pub mod equations;
 mod error;
