@@ -1,14 +1,25 @@
 //! The DAE layer: residual and sparse Jacobians of the equations of motion (Eq. 13a–13e),
 //! initialization (assembly), and the integrator (Radau IIA on the stabilized system).
 
+mod assembly_moves;
+pub mod bytes;
 pub mod counts;
 pub mod equations;
+mod error;
 pub mod init;
+mod observe;
+mod options;
+mod problem;
 pub mod radau;
 mod radau_tableau;
 pub mod rank;
 mod simulator;
+mod snapshot;
 pub mod sparse;
 
+pub use error::EngineError;
+pub use observe::BodyState;
+pub use options::SimOptions;
 pub use radau::{BATCH_MAX_STEPS, DEFAULT_MAX_STEPS};
-pub use simulator::{BodyState, EngineError, SimOptions, SimState, Simulator};
+pub use simulator::Simulator;
+pub use snapshot::SimState;

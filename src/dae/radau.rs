@@ -296,8 +296,25 @@ impl Radau {
 
     /// One step attempt of size h: (accepted?, proposed next h).
     fn step<P: DaeProblem>(&mut self, p: &mut P, h: f64) -> Result<(bool, f64), String> {
-        let n = self.y.len();
         self.stats.steps += 1;
+        self.refresh_jacobian(p)?;
+        if self.h_fact != h && self.factor(self.y.len(), h).is_err() {
+            return Ok((false, self.reject_singular(h)));
+        }
+        let mut z = self.predict_stages(h);
+        let (iterations, theta) = match self.newton(p, h, &mut z) {
+            Ok(converged) => converged,
+            Err(h_next) => return Ok((false, h_next)),
+        };
+        let Some(err) = self.error_estimate(p, h, &z) else {
+            return Ok((false, self.newton_failed(h, "the error estimate is not finite")));
+        };
+        let hnew = self.proposed_step(h, err, iterations);
+        if err < 1.0 { Ok((true, self.accept(p, h, hnew, &z, theta))) } else { Ok((false, self.reject_error(h, hnew))) }
+    }
+
+    /// f(t, y) and the Jacobian at the current point, when they are not up to date.
+    fn refresh_jacobian<P: DaeProblem>(&mut self, p: &mut P) -> Result<(), String> {
         if !self.f0_valid {
             p.rhs(self.t, &self.y, &mut self.f0)?;
             self.stats.rhs_evaluations += 1;
@@ -311,15 +328,14 @@ impl Radau {
             self.need_jac = false;
             self.h_fact = f64::NAN;
         }
-        if self.h_fact != h && self.factor(n, h).is_err() {
-            self.stats.rejected += 1;
-            self.last_reject = "the iteration matrix is singular";
-            self.need_jac = !self.jac_fresh;
-            return Ok((false, 0.5 * h));
-        }
-        let tb = self.tb.clone();
-        let scal = self.scal(&self.y, h);
-        // Starting values: extrapolate the previous collocation polynomial.
+        Ok(())
+    }
+
+    /// Starting values of the stage increments Z: the previous collocation polynomial
+    /// extrapolated (zero without one).
+    fn predict_stages(&self, h: f64) -> [Vec<f64>; 3] {
+        let n = self.y.len();
+        let tb = self.tb;
         let mut z: [Vec<f64>; 3] = std::array::from_fn(|_| vec![0.0; n]);
         if let Some(c) = &self.cont {
             let c3q = h / self.h_old;
@@ -330,43 +346,33 @@ impl Radau {
                 }
             }
         }
+        z
+    }
+
+    /// Simplified Newton iteration on the transformed collocation system, from the stage
+    /// increments `z` (solved in place). Ok: (iterations, last contraction rate θ); Err:
+    /// the attempt is rejected, with the step size to try next.
+    fn newton<P: DaeProblem>(&mut self, p: &mut P, h: f64, z: &mut [Vec<f64>; 3]) -> Result<(usize, f64), f64> {
+        let n = self.y.len();
+        let tb = self.tb;
+        let scal = self.scal(&self.y, h);
         let mut w: [Vec<f64>; 3] =
             std::array::from_fn(|r| (0..n).map(|i| (0..3).map(|s| tb.ti[r][s] * z[s][i]).sum()).collect());
-        // Simplified Newton iteration.
         let fnewt = (10.0 * f64::EPSILON / self.rtol).max(0.03f64.min(self.rtol.sqrt()));
         let mut faccon = self.faccon.max(f64::EPSILON).powf(0.8);
         let mut dyno_old = 0.0;
         let mut theta = 1.0;
         let mut newt = 0;
-        let mut yi = vec![0.0; n];
-        let mut f: [Vec<f64>; 3] = std::array::from_fn(|_| vec![0.0; n]);
         loop {
             if newt >= NIT {
-                return self.newton_failed(h, "the Newton iteration did not converge");
+                return Err(self.newton_failed(h, "the Newton iteration did not converge"));
             }
-            for s in 0..3 {
-                for i in 0..n {
-                    yi[i] = self.y[i] + z[s][i];
-                }
-                if p.rhs(self.t + tb.c[s] * h, &yi, &mut f[s]).is_err() {
-                    return self.newton_failed(h, "the equations are not finite at a Newton iterate");
-                }
-                self.stats.rhs_evaluations += 1;
-            }
-            // G = (T⁻¹ ⊗ I) F, then the Newton right-hand sides.
-            let g: [Vec<f64>; 3] =
-                std::array::from_fn(|r| (0..n).map(|i| (0..3).map(|s| tb.ti[r][s] * f[s][i]).sum()).collect());
-            let mw0 = self.mass_mul(&w[0]);
-            let mw1 = self.mass_mul(&w[1]);
-            let mw2 = self.mass_mul(&w[2]);
-            let mut r1: Vec<f64> = (0..n).map(|i| g[0][i] - tb.gamma / h * mw0[i]).collect();
-            let mut r23: Vec<f64> = (0..n)
-                .map(|i| g[1][i] - (tb.alpha * mw1[i] + tb.beta * mw2[i]) / h)
-                .chain((0..n).map(|i| g[2][i] - (-tb.beta * mw1[i] + tb.alpha * mw2[i]) / h))
-                .collect();
-            if !self.lu1.solve(&mut r1) || !self.lu2.solve(&mut r23) {
-                return self.newton_failed(h, "a Newton update is not finite");
-            }
+            let Some(f) = self.stage_rhs(p, h, z) else {
+                return Err(self.newton_failed(h, "the equations are not finite at a Newton iterate"));
+            };
+            let Some((r1, r23)) = self.newton_increment(h, &f, &w) else {
+                return Err(self.newton_failed(h, "a Newton update is not finite"));
+            };
             newt += 1;
             self.stats.newton_iterations += 1;
             let mut sum = 0.0;
@@ -377,18 +383,12 @@ impl Radau {
             if newt > 1 && newt < NIT {
                 theta = dyno / dyno_old;
                 if theta >= 0.99 {
-                    return self.newton_failed(h, "the Newton iteration diverged");
+                    return Err(self.newton_failed(h, "the Newton iteration diverged"));
                 }
                 faccon = theta / (1.0 - theta);
                 let dyth = faccon * dyno * theta.powi((NIT - 1 - newt) as i32) / fnewt;
                 if dyth >= 1.0 {
-                    let qnewt = dyth.clamp(1e-4, 20.0);
-                    let hhfac = 0.8 * qnewt.powf(-1.0 / (4.0 + (NIT - 1 - newt) as f64));
-                    self.stats.rejected += 1;
-                    self.last_rejected = true;
-                    self.last_reject = "the Newton iteration converged too slowly";
-                    self.need_jac = !self.jac_fresh;
-                    return Ok((false, h * hhfac));
+                    return Err(self.reject_slow_newton(h, dyth, newt));
                 }
             }
             dyno_old = dyno.max(f64::EPSILON);
@@ -407,7 +407,50 @@ impl Radau {
             }
         }
         self.faccon = faccon;
-        // Embedded error estimate.
+        Ok((newt, theta))
+    }
+
+    /// f at the three stages, y + Z_s at t + c_s h (None if not finite there).
+    fn stage_rhs<P: DaeProblem>(&mut self, p: &mut P, h: f64, z: &[Vec<f64>; 3]) -> Option<[Vec<f64>; 3]> {
+        let n = self.y.len();
+        let mut yi = vec![0.0; n];
+        let mut f: [Vec<f64>; 3] = std::array::from_fn(|_| vec![0.0; n]);
+        for s in 0..3 {
+            for i in 0..n {
+                yi[i] = self.y[i] + z[s][i];
+            }
+            p.rhs(self.t + self.tb.c[s] * h, &yi, &mut f[s]).ok()?;
+            self.stats.rhs_evaluations += 1;
+        }
+        Some(f)
+    }
+
+    /// The Newton increments of the transformed stage unknowns W from the stage values
+    /// `f`: (ΔW₁, [ΔW₂; ΔW₃]) from the real and the complex-pair block (None if not
+    /// finite).
+    fn newton_increment(&mut self, h: f64, f: &[Vec<f64>; 3], w: &[Vec<f64>; 3]) -> Option<(Vec<f64>, Vec<f64>)> {
+        let n = self.y.len();
+        let tb = self.tb;
+        // G = (T⁻¹ ⊗ I) F, then the Newton right-hand sides.
+        let g: [Vec<f64>; 3] =
+            std::array::from_fn(|r| (0..n).map(|i| (0..3).map(|s| tb.ti[r][s] * f[s][i]).sum()).collect());
+        let mw0 = self.mass_mul(&w[0]);
+        let mw1 = self.mass_mul(&w[1]);
+        let mw2 = self.mass_mul(&w[2]);
+        let mut r1: Vec<f64> = (0..n).map(|i| g[0][i] - tb.gamma / h * mw0[i]).collect();
+        let mut r23: Vec<f64> = (0..n)
+            .map(|i| g[1][i] - (tb.alpha * mw1[i] + tb.beta * mw2[i]) / h)
+            .chain((0..n).map(|i| g[2][i] - (-tb.beta * mw1[i] + tb.alpha * mw2[i]) / h))
+            .collect();
+        (self.lu1.solve(&mut r1) && self.lu2.solve(&mut r23)).then_some((r1, r23))
+    }
+
+    /// The embedded error estimate of the step with stage increments `z` (RADAU5): the
+    /// RMS over the differential components, scaled by the tolerances; None if not
+    /// finite.
+    fn error_estimate<P: DaeProblem>(&mut self, p: &mut P, h: f64, z: &[Vec<f64>; 3]) -> Option<f64> {
+        let n = self.y.len();
+        let tb = self.tb;
         let f2: Vec<f64> = (0..n).map(|i| (tb.dd[0] * z[0][i] + tb.dd[1] * z[1][i] + tb.dd[2] * z[2][i]) / h).collect();
         let mf2 = self.mass_mul(&f2);
         let mut cont: Vec<f64> = (0..n).map(|i| mf2[i] + self.f0[i]).collect();
@@ -425,6 +468,7 @@ impl Radau {
             (s / k.max(1) as f64).sqrt().max(1e-10)
         };
         let mut err = norm(&cont);
+        // A first step or one after a rejection: refine the estimate with f at y + estimate.
         if err >= 1.0 && (self.first || self.last_rejected) {
             let y1: Vec<f64> = (0..n).map(|i| self.y[i] + cont[i]).collect();
             let mut ft = vec![0.0; n];
@@ -435,62 +479,171 @@ impl Radau {
                 err = norm(&cont);
             }
         }
-        if !err.is_finite() {
-            return self.newton_failed(h, "the error estimate is not finite");
-        }
-        let fac = SAFE.min(SAFE * (1 + 2 * NIT) as f64 / (newt + 2 * NIT) as f64);
-        let quot = FACR.max(FACL.min(err.powf(0.25) / fac));
-        let mut hnew = (h / quot).min(self.max_step);
-        if err < 1.0 {
-            // After a rejection, do not grow beyond the step that just succeeded (RADAU5).
-            if self.last_rejected {
-                hnew = hnew.min(h);
-            }
-            // Accept: y ← y + Z₃, keep the collocation polynomial for extrapolation.
-            let c = tb.c;
-            let mut cc: [Vec<f64>; 3] = std::array::from_fn(|_| vec![0.0; n]);
-            for i in 0..n {
-                let (z1, z2, z3) = (z[0][i], z[1][i], z[2][i]);
-                let ak = (z1 - z2) / (c[0] - c[1]);
-                cc[0][i] = (z2 - z3) / (c[1] - 1.0);
-                let acont3 = (ak - z1 / c[0]) / c[1];
-                cc[1][i] = (ak - cc[0][i]) / (c[0] - 1.0);
-                cc[2][i] = cc[1][i] - acont3;
-                self.y[i] += z3;
-            }
-            self.t += h;
-            self.h_old = h;
-            self.cont = Some(cc);
-            self.first = false;
-            self.last_rejected = false;
-            self.stats.accepted += 1;
-            self.jac_fresh = false;
-            self.need_jac = theta > THET;
-            self.f0_valid = false;
-            if p.accepted(self.t, &mut self.y) {
-                self.cont = None;
-                self.need_jac = true;
-            }
-            // Keep h (and the factorization) when the change would be small (RADAU5's
-            // quot1/quot2 window): refactoring costs more than a slightly short step.
-            let keep = !self.need_jac && (1.0..=1.2).contains(&(hnew / h));
-            Ok((true, if keep { h } else { hnew }))
-        } else {
-            self.stats.rejected += 1;
-            self.last_rejected = true;
-            self.last_reject = "the local error test failed";
-            let hn = if self.first { 0.1 * h } else { hnew };
-            self.need_jac = !self.jac_fresh;
-            Ok((false, hn))
-        }
+        err.is_finite().then_some(err)
     }
 
-    fn newton_failed(&mut self, h: f64, why: &'static str) -> Result<(bool, f64), String> {
+    /// The next step size the error `err` of a step of size `h` calls for, after
+    /// `iterations` Newton iterations (RADAU5's controller, bounded by [`Radau::max_step`]).
+    fn proposed_step(&self, h: f64, err: f64, iterations: usize) -> f64 {
+        let fac = SAFE.min(SAFE * (1 + 2 * NIT) as f64 / (iterations + 2 * NIT) as f64);
+        let quot = FACR.max(FACL.min(err.powf(0.25) / fac));
+        (h / quot).min(self.max_step)
+    }
+
+    /// Accept the step: y ← y + Z₃, t ← t + h, keep the collocation polynomial for
+    /// extrapolation, tell the problem. Returns the next step size from the proposed
+    /// `hnew`.
+    fn accept<P: DaeProblem>(&mut self, p: &mut P, h: f64, mut hnew: f64, z: &[Vec<f64>; 3], theta: f64) -> f64 {
+        let n = self.y.len();
+        // After a rejection, do not grow beyond the step that just succeeded (RADAU5).
+        if self.last_rejected {
+            hnew = hnew.min(h);
+        }
+        let c = self.tb.c;
+        let mut cc: [Vec<f64>; 3] = std::array::from_fn(|_| vec![0.0; n]);
+        for i in 0..n {
+            let (z1, z2, z3) = (z[0][i], z[1][i], z[2][i]);
+            let ak = (z1 - z2) / (c[0] - c[1]);
+            cc[0][i] = (z2 - z3) / (c[1] - 1.0);
+            let acont3 = (ak - z1 / c[0]) / c[1];
+            cc[1][i] = (ak - cc[0][i]) / (c[0] - 1.0);
+            cc[2][i] = cc[1][i] - acont3;
+            self.y[i] += z3;
+        }
+        self.t += h;
+        self.h_old = h;
+        self.cont = Some(cc);
+        self.first = false;
+        self.last_rejected = false;
+        self.stats.accepted += 1;
+        self.jac_fresh = false;
+        self.need_jac = theta > THET;
+        self.f0_valid = false;
+        if p.accepted(self.t, &mut self.y) {
+            self.cont = None;
+            self.need_jac = true;
+        }
+        // Keep h (and the factorization) when the change would be small (RADAU5's
+        // quot1/quot2 window): refactoring costs more than a slightly short step.
+        let keep = !self.need_jac && (1.0..=1.2).contains(&(hnew / h));
+        if keep { h } else { hnew }
+    }
+
+    /// Reject a step that failed the error test; returns the step size to try next.
+    fn reject_error(&mut self, h: f64, hnew: f64) -> f64 {
+        self.stats.rejected += 1;
+        self.last_rejected = true;
+        self.last_reject = "the local error test failed";
+        let hn = if self.first { 0.1 * h } else { hnew };
+        self.need_jac = !self.jac_fresh;
+        hn
+    }
+
+    /// Reject a step whose iteration matrix could not be factored; returns the step size
+    /// to try next.
+    fn reject_singular(&mut self, h: f64) -> f64 {
+        self.stats.rejected += 1;
+        self.last_reject = "the iteration matrix is singular";
+        self.need_jac = !self.jac_fresh;
+        0.5 * h
+    }
+
+    /// Reject a step whose Newton iteration, at contraction estimate `dyth` after
+    /// `newt` iterations, would not converge in time; returns the step size to try next.
+    fn reject_slow_newton(&mut self, h: f64, dyth: f64, newt: usize) -> f64 {
+        let qnewt = dyth.clamp(1e-4, 20.0);
+        let hhfac = 0.8 * qnewt.powf(-1.0 / (4.0 + (NIT - 1 - newt) as f64));
+        self.stats.rejected += 1;
+        self.last_rejected = true;
+        self.last_reject = "the Newton iteration converged too slowly";
+        self.need_jac = !self.jac_fresh;
+        h * hhfac
+    }
+
+    /// Reject a step whose Newton iteration failed (`why`); returns the step size to try
+    /// next.
+    fn newton_failed(&mut self, h: f64, why: &'static str) -> f64 {
         self.stats.rejected += 1;
         self.last_reject = why;
         self.last_rejected = true;
         self.need_jac = !self.jac_fresh;
         self.cont = None;
-        Ok((false, 0.5 * h))
+        0.5 * h
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::dae::{SimOptions, Simulator};
+
+    /// 64-bit FNV-1a.
+    fn fnv64(bytes: &[u8]) -> u64 {
+        bytes.iter().fold(0xcbf29ce484222325u64, |h, &b| (h ^ b as u64).wrapping_mul(0x100000001b3))
+    }
+
+    fn simulator(file: &str, opts: SimOptions) -> Simulator {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(file);
+        Simulator::new(&crate::model::parse::load_file(&path).unwrap(), opts, 0.0).unwrap()
+    }
+
+    /// The integrator's arithmetic is pinned: runs of the example models (accepted and
+    /// rejected steps, a step-size collapse, the step limit) end in the engine states, bit
+    /// for bit, and the step counts recorded before `Radau::step` was split into its
+    /// phases (commit e57e189). Update the table only for an intended numerical change.
+    ///
+    /// faer's dense kernels choose their SIMD path at run time, and another instruction
+    /// set rounds differently, so the bits are checked only on x86-64 with AVX-512F, AVX2
+    /// and FMA, where they were recorded.
+    #[test]
+    fn runs_reproduce_the_recorded_engine_states_bit_for_bit() {
+        #[cfg(target_arch = "x86_64")]
+        let recorded_here = std::arch::is_x86_feature_detected!("avx512f")
+            && std::arch::is_x86_feature_detected!("avx2")
+            && std::arch::is_x86_feature_detected!("fma");
+        #[cfg(not(target_arch = "x86_64"))]
+        let recorded_here = false;
+        if !recorded_here {
+            eprintln!("skipped: the recorded bits are those of x86-64 with AVX-512F, AVX2 and FMA");
+            return;
+        }
+        let table: [(&str, u64, usize); 12] = [
+            ("pendulum", 0xb6e9a7d8d3d0a067, 28),
+            ("double_pendulum", 0x520f5df9ebe2a83d, 52),
+            ("fourbar", 0xff42f2191abe2379, 212),
+            ("slider_crank", 0x95e9271328b17c7c, 23),
+            ("spinning_top", 0xc19e9b40380d00d0, 400),
+            ("chaplygin_sleigh", 0xf210b3b808053eca, 7),
+            ("rolling_disc", 0x9cbde4aeff84deb6, 7),
+            ("cart_pendulum_pid", 0xa5e521aacf524c42, 7),
+            ("benchmark_bicycle", 0x21cebf472374a01b, 7),
+            ("blade_alpha", 0xa8d52062b5a9cc77, 87),
+            ("spring_mass_damper", 0xf60c6b2d1579c808, 34),
+            ("torque_free_body", 0x01346391f301b1ba, 11),
+        ];
+        for (name, hash, steps) in table {
+            let mut s = simulator(&format!("models/{name}.xml"), SimOptions::default());
+            s.advance(0.5).unwrap();
+            s.advance(1.0).unwrap();
+            assert_eq!((fnv64(&s.snapshot().to_bytes()), s.stats().steps), (hash, steps), "{name}");
+        }
+        // Tight tolerance with a bounded step.
+        let mut s = simulator(
+            "models/double_pendulum.xml",
+            SimOptions { tol: 1e-10, max_step: Some(0.05), ..Default::default() },
+        );
+        s.advance(2.0).unwrap();
+        assert_eq!((fnv64(&s.snapshot().to_bytes()), s.stats().steps), (0x0de4b65a962a4d9f, 354));
+        // A step-size collapse in the toggle position: many rejected steps.
+        let mut s = simulator("tests/models/fourbar_toggle.xml", SimOptions::default());
+        assert!(s.advance(2.2).is_err());
+        assert_eq!(
+            (fnv64(&s.snapshot().to_bytes()), s.stats().steps, s.stats().rejected),
+            (0x2db44c416c269730, 267, 152)
+        );
+        // The step limit.
+        let mut s = simulator("models/cart_pendulum_pid.xml", SimOptions { max_steps: 50, ..Default::default() });
+        s.set_input_derivative(0, 1.0);
+        assert!(s.advance(1e6).is_err());
+        assert_eq!((fnv64(&s.snapshot().to_bytes()), s.stats().steps), (0x3ce9457561db6986, 50));
     }
 }

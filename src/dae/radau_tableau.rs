@@ -4,7 +4,7 @@
 use nalgebra::Matrix3;
 
 /// Radau IIA constants used by the integrator.
-#[derive(Clone, Debug)]
+#[derive(Clone, Copy, Debug)]
 pub struct Tableau {
     /// Collocation nodes.
     pub c: [f64; 3],

@@ -5,6 +5,7 @@ use super::guid::checksum;
 use super::instance::{Config, Instance};
 use super::state_machine::State;
 use crate::dae::SimState;
+use crate::dae::bytes::{ByteReader, ByteWriter};
 
 const MAGIC: &[u8; 8] = b"MBFMUF02";
 
@@ -65,29 +66,29 @@ impl FmuState {
         Ok(())
     }
 
-    /// fmi2SerializeFMUstate: magic, GUID, state, configuration (with `solver.maxSteps`),
-    /// engine state.
+    /// fmi2SerializeFMUstate: the magic `MBFMUF02`, GUID, state, configuration (with
+    /// `solver.maxSteps`), engine state, and a checksum of all before it.
     pub fn to_bytes(&self) -> Vec<u8> {
-        let mut w = Writer(MAGIC.to_vec());
+        let mut w = ByteWriter::new(MAGIC);
         w.bytes(self.guid.as_bytes());
-        w.0.push(State::ALL.iter().position(|s| *s == self.state).expect("listed") as u8);
+        w.u8(State::ALL.iter().position(|s| *s == self.state).expect("listed") as u8);
         let c = &self.config;
         w.f64s(&[c.tol, c.start, c.stop.unwrap_or(f64::NAN), self.last_time]);
-        w.0.push(c.stop.is_some() as u8);
+        w.u8(c.stop.is_some() as u8);
         w.f64s(&c.params);
         w.f64s(&c.inputs);
         w.f64s(&c.slopes);
-        w.0.extend_from_slice(&(c.max_steps as u64).to_le_bytes());
+        w.u64(c.max_steps as u64);
         match &self.sim {
             Some(s) => {
-                w.0.push(1);
+                w.u8(1);
                 w.bytes(&s.to_bytes());
             }
-            None => w.0.push(0),
+            None => w.u8(0),
         }
-        let sum = checksum(&w.0);
-        w.0.extend_from_slice(&sum.to_le_bytes());
-        w.0
+        let sum = checksum(w.as_slice());
+        w.u64(sum);
+        w.finish()
     }
 
     /// fmi2DeSerializeFMUstate: what [`FmuState::to_bytes`] wrote.
@@ -100,20 +101,20 @@ impl FmuState {
         if checksum(&b[..MAGIC.len() + body.len()]).to_le_bytes() != sum {
             return Err("the serialized state is corrupted (checksum mismatch)".into());
         }
-        let mut r = Reader { b: body, pos: 0 };
+        let mut r = ByteReader::new(body);
         let guid = String::from_utf8(r.bytes().ok_or_else(bad)?.to_vec()).map_err(|_| bad())?;
-        let state = *State::ALL.get(r.byte().ok_or_else(bad)? as usize).ok_or_else(bad)?;
+        let state = *State::ALL.get(r.u8().ok_or_else(bad)? as usize).ok_or_else(bad)?;
         let head = r.f64s().ok_or_else(bad)?;
-        let has_stop = r.byte().ok_or_else(bad)? == 1;
+        let has_stop = r.u8().ok_or_else(bad)? == 1;
         let (params, inputs, slopes) =
             (r.f64s().ok_or_else(bad)?, r.f64s().ok_or_else(bad)?, r.f64s().ok_or_else(bad)?);
-        let max_steps = r.len().filter(|&n| n >= 1).ok_or_else(bad)?;
-        let sim = match r.byte().ok_or_else(bad)? {
+        let max_steps = r.usize().filter(|&n| n >= 1).ok_or_else(bad)?;
+        let sim = match r.u8().ok_or_else(bad)? {
             0 => None,
             1 => Some(SimState::from_bytes(r.bytes().ok_or_else(bad)?).map_err(|e| e.to_string())?),
             _ => return Err(bad()),
         };
-        if head.len() != 4 || r.pos != r.b.len() {
+        if head.len() != 4 || !r.at_end() {
             return Err(bad());
         }
         let stop = has_stop.then_some(head[2]);
@@ -126,50 +127,74 @@ fn same(a: &[f64], b: &[f64]) -> bool {
     a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
 }
 
-struct Writer(Vec<u8>);
+#[cfg(test)]
+mod tests {
+    use super::*;
 
-impl Writer {
-    fn bytes(&mut self, b: &[u8]) {
-        self.0.extend_from_slice(&(b.len() as u64).to_le_bytes());
-        self.0.extend_from_slice(b);
+    /// States serialized by the codec before `dae::bytes` existed (commit e57e189): GUID
+    /// `{0123abcd-0000-1111-2222-333344445555}`, params [9.81, 1.5], inputs [7, 8], slopes
+    /// [0, −1], tol 1e-6, start 0, last time 0.25, `solver.maxSteps` 12345; the first
+    /// StepComplete with stop 10 and a small engine state, the second Instantiated without
+    /// stop or engine.
+    const WITH_ENGINE: [&str; 11] = [
+        "4d42464d5546303226000000000000007b30313233616263642d303030302d313131312d323232322d33333333343434",
+        "34353535357d0204000000000000008dedb5a0f7c6b03e00000000000000000000000000002440000000000000d03f01",
+        "02000000000000001f85eb51b89e2340000000000000f83f02000000000000000000000000001c400000000000002040",
+        "02000000000000000000000000000000000000000000f0bf39300000000000000130010000000000004d42464d555330",
+        "320400000000000000000000000000d03ffca9f1d24d62503f9a9999999999b93f9a9999999999c93f03000000000000",
+        "00000000000000f03f00000000000004c0000000000000f87f0900000000000000000000000000f03f00000000000000",
+        "00000000000000000000000000000000000000000000000000000000000000f0bf0000000000000000000000000000f0",
+        "3f00000000000000000100000000000000000000000000e03f0100000000000000000000000000c0bf01000000000000",
+        "00000000000000084002000000000000000000000000001c400000000000002040020000000000000000000000000000",
+        "00000000000000f0bf0500000000000000fca9f1d24d62503f000000000000e03f0000000000000000000000000000f0",
+        "3f00000000000000009c3d212cb75d1e0a",
+    ];
+    const WITHOUT_ENGINE: [&str; 4] = [
+        "4d42464d5546303226000000000000007b30313233616263642d303030302d313131312d323232322d33333333343434",
+        "34353535357d0004000000000000008dedb5a0f7c6b03e0000000000000000000000000000f87f000000000000d03f00",
+        "02000000000000001f85eb51b89e2340000000000000f83f02000000000000000000000000001c400000000000002040",
+        "02000000000000000000000000000000000000000000f0bf393000000000000000872e31260fb3d386",
+    ];
+
+    fn unhex(parts: &[&str]) -> Vec<u8> {
+        let s: String = parts.concat();
+        (0..s.len()).step_by(2).map(|i| u8::from_str_radix(&s[i..i + 2], 16).unwrap()).collect()
     }
 
-    fn f64s(&mut self, v: &[f64]) {
-        self.0.extend_from_slice(&(v.len() as u64).to_le_bytes());
-        for x in v {
-            self.0.extend_from_slice(&x.to_le_bytes());
+    #[test]
+    fn states_saved_by_the_earlier_codec_load_and_serialize_to_the_same_bytes() {
+        for (hex, state, stop, engine) in [
+            (&WITH_ENGINE[..], State::StepComplete, Some(10.0), true),
+            (&WITHOUT_ENGINE[..], State::Instantiated, None, false),
+        ] {
+            let old = unhex(hex);
+            let s = FmuState::from_bytes(&old).unwrap();
+            assert_eq!(s.to_bytes(), old);
+            assert_eq!(s.guid, "{0123abcd-0000-1111-2222-333344445555}");
+            assert_eq!(s.state, state);
+            let want = Config {
+                params: vec![9.81, 1.5],
+                inputs: vec![7.0, 8.0],
+                slopes: vec![0.0, -1.0],
+                tol: 1e-6,
+                start: 0.0,
+                stop,
+                max_steps: 12345,
+            };
+            assert_eq!(s.config, want);
+            assert_eq!(s.last_time, 0.25);
+            assert_eq!(s.sim.is_some(), engine);
+            if let Some(sim) = &s.sim {
+                assert_eq!((sim.t, sim.h, sim.y.len(), sim.integrator.len()), (0.25, 1e-3, 3, 5));
+                assert!(sim.y[2].is_nan());
+            }
+            // A changed byte fails the checksum; a cut is refused.
+            let mut bad = old.clone();
+            bad[20] ^= 1;
+            assert!(FmuState::from_bytes(&bad).unwrap_err().contains("checksum"));
+            for cut in 0..old.len() {
+                assert!(FmuState::from_bytes(&old[..cut]).is_err(), "cut at {cut}");
+            }
         }
-    }
-}
-
-struct Reader<'a> {
-    b: &'a [u8],
-    pos: usize,
-}
-
-impl<'a> Reader<'a> {
-    fn take(&mut self, n: usize) -> Option<&'a [u8]> {
-        let s = self.b.get(self.pos..self.pos.checked_add(n)?)?;
-        self.pos += n;
-        Some(s)
-    }
-
-    fn byte(&mut self) -> Option<u8> {
-        Some(self.take(1)?[0])
-    }
-
-    fn len(&mut self) -> Option<usize> {
-        usize::try_from(u64::from_le_bytes(self.take(8)?.try_into().ok()?)).ok()
-    }
-
-    fn bytes(&mut self) -> Option<&'a [u8]> {
-        let n = self.len()?;
-        self.take(n)
-    }
-
-    fn f64s(&mut self) -> Option<Vec<f64>> {
-        let n = self.len()?;
-        let raw = self.take(n.checked_mul(8)?)?;
-        Some(raw.chunks_exact(8).map(|c| f64::from_le_bytes(c.try_into().expect("8 bytes"))).collect())
     }
 }
