@@ -1,5 +1,5 @@
 //! A full FMU lifecycle through the exported FMI 2.0 C functions, as a host drives it:
-//! the program tests/memory_valgrind.rs runs under valgrind memcheck (issue 12 item 6).
+//! the program tests/it/memory_valgrind.rs runs under valgrind memcheck (issue 12 item 6).
 //! Every status is checked; any failure prints the instance's last messages and exits 1.
 //!
 //! Usage: cargo run --release --example fmu_lifecycle -- MODEL.xml [--steps N]
@@ -28,7 +28,7 @@ use std::ffi::CString;
 use std::path::Path;
 use std::time::Instant;
 
-#[path = "../tests/common/host.rs"]
+#[path = "../tests/it/common/host.rs"]
 mod host;
 use host::{CALLBACKS, resources};
 

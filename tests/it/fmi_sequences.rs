@@ -9,6 +9,8 @@
 //! `MBFMU_FMI_SEQUENCES` (default 300, what CI runs) sets how many sequences;
 //! `MBFMU_FMI_SEED` the base seed; `bench/fmi_sequences.sh` runs thousands.
 
+use crate::common::host::{CALLBACKS, resources};
+use crate::common::model_files;
 use mbfmu::fmi::exports_common::*;
 use mbfmu::fmi::exports_cs::*;
 use mbfmu::fmi::exports_me::*;
@@ -20,12 +22,7 @@ use mbfmu::fmi::types::{
 use mbfmu::fmi::variables::{Causality, variables};
 use std::collections::BTreeMap;
 use std::ffi::CString;
-use std::path::PathBuf;
 use std::time::{Duration, Instant};
-
-#[path = "common/host.rs"]
-mod host;
-use host::{CALLBACKS, resources};
 
 /// The longest any single call may take. A doStep is bounded by `solver.maxSteps`; the
 /// sequences set it to at most [`MAX_STEPS`] (or leave the default), so on these models a
@@ -82,11 +79,7 @@ struct Model {
 }
 
 fn models() -> Vec<Model> {
-    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    let mut files: Vec<PathBuf> = std::fs::read_dir(root.join("models")).unwrap().map(|e| e.unwrap().path()).collect();
-    files.retain(|p| p.extension().is_some_and(|e| e == "xml"));
-    files.sort();
-    files
+    model_files()
         .iter()
         .map(|path| {
             let text = std::fs::read_to_string(path).unwrap();

@@ -2,6 +2,8 @@
 //! the engine's own, FMU states, parameters, every refused call with its message, engine
 //! failures as fmi2Discard, and many instances.
 
+use crate::common::host::{CALLBACKS, resources};
+use crate::common::model_text;
 use mbfmu::dae::{SimOptions, Simulator};
 use mbfmu::fmi::exports_common::*;
 use mbfmu::fmi::exports_cs::*;
@@ -11,15 +13,6 @@ use mbfmu::fmi::guid::guid;
 use mbfmu::fmi::state_machine::State;
 use mbfmu::fmi::types::{CO_SIMULATION, Component, LAST_SUCCESSFUL_TIME, MODEL_EXCHANGE, Status};
 use std::ffi::CString;
-use std::path::PathBuf;
-
-#[path = "common/host.rs"]
-mod host;
-use host::{CALLBACKS, resources};
-
-fn model_text(name: &str) -> String {
-    std::fs::read_to_string(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("models").join(name)).unwrap()
-}
 
 fn instantiate_with(text: &str, fmu_type: i32, guid_s: &str) -> Component {
     let (name, g, uri) = (c"inst", CString::new(guid_s).unwrap(), resources(text, "capi").1);

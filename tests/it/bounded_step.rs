@@ -3,6 +3,8 @@
 //! a step-size collapse at a lock-up) returns fmi2Discard with fmi2LastSuccessfulTime =
 //! the time reached; restoring an FMU state lets the host retry or continue.
 
+use crate::common::host::{CALLBACKS, resources};
+use crate::common::{model_text, root};
 use mbfmu::dae::{DEFAULT_MAX_STEPS, SimOptions, Simulator};
 use mbfmu::fmi::exports_common::*;
 use mbfmu::fmi::exports_cs::*;
@@ -14,23 +16,10 @@ use mbfmu::fmi::types::{CO_SIMULATION, Component, LAST_SUCCESSFUL_TIME, Status};
 use mbfmu::fmi::variables::{MAX_STEPS_NAME, variables};
 use mbfmu::model::parse::load_str;
 use std::ffi::CString;
-use std::path::PathBuf;
 use std::time::Instant;
-
-#[path = "common/host.rs"]
-mod host;
-use host::{CALLBACKS, resources};
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
 
 fn toggle_text() -> String {
     std::fs::read_to_string(root().join("tests/models/fourbar_toggle.xml")).unwrap()
-}
-
-fn model_text(name: &str) -> String {
-    std::fs::read_to_string(root().join("models").join(name)).unwrap()
 }
 
 /// Toggle geometry of tests/models/fourbar_toggle.xml: crank a, coupler b, rocker c,
