@@ -1,5 +1,5 @@
 //! A full FMU lifecycle through the exported FMI 2.0 C functions, as a host drives it:
-//! the program tests/memory_valgrind.rs runs under valgrind memcheck (issue 12 item 6).
+//! the program tests/it/memory_valgrind.rs runs under valgrind memcheck (issue 12 item 6).
 //! Every status is checked; any failure prints the instance's last messages and exits 1.
 //!
 //! Usage: cargo run --release --example fmu_lifecycle -- MODEL.xml [--steps N]
@@ -28,18 +28,18 @@ use std::ffi::CString;
 use std::path::Path;
 use std::time::Instant;
 
-#[path = "../tests/common/host.rs"]
+#[path = "../tests/it/common/host.rs"]
 mod host;
-use host::{CALLBACKS, resources};
+use host::resources;
 
 /// Communication step size.
 const H: f64 = 0.01;
 
-/// Print what failed, with the instance's last messages, and exit 1.
+/// Print what failed, with the last messages the instance gave its logger, and exit 1.
 fn fail(c: Component, what: &str) -> ! {
-    // SAFETY: `c` is checked against the live instances.
-    let msgs = if c.is_null() { Vec::new() } else { unsafe { last_messages(c) } };
-    eprintln!("fmu_lifecycle: FAILED: {what}; last messages: {msgs:?}");
+    let msgs = host::messages(c);
+    let last = &msgs[msgs.len().saturating_sub(64)..];
+    eprintln!("fmu_lifecycle: FAILED: {what}; last messages: {last:?}");
     std::process::exit(1)
 }
 
@@ -52,8 +52,8 @@ fn ok(c: Component, status: Status, what: &str) {
 
 fn instantiate(guid_s: &str, uri: &CString) -> Component {
     let g = CString::new(guid_s).expect("no NUL in a GUID");
-    // SAFETY: valid NUL-terminated strings and callbacks.
-    unsafe { fmi2Instantiate(c"lifecycle".as_ptr(), CO_SIMULATION, g.as_ptr(), uri.as_ptr(), &CALLBACKS, 0, 1) }
+    // SAFETY: valid NUL-terminated strings; the host's callbacks with a recording logger.
+    unsafe { host::instantiate(c"lifecycle".as_ptr(), CO_SIMULATION, g.as_ptr(), uri.as_ptr(), 0, 1) }
 }
 
 fn get_reals(c: Component, vrs: &[u32], what: &str) -> Vec<f64> {
@@ -309,7 +309,7 @@ fn lifecycle(p: &Plan) -> String {
         get_reals(c, &p.outputs, "fmi2GetReal after fmi2Reset and fmi2SetFMUstate");
         ok(c, fmi2Terminate(c), "fmi2Terminate");
         get_reals(c, &p.outputs, "fmi2GetReal when terminated");
-        fmi2FreeInstance(c);
+        host::free(c);
     }
     std::fs::remove_dir_all(&top).unwrap_or_else(|e| panic!("{}: {e}", top.display()));
     format!(

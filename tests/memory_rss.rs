@@ -9,6 +9,11 @@
 //! lock; nextest runs each in its own process anyway). The warm-up and the measured
 //! cycles run each on a thread of their own: the host's threads come and go, and a
 //! thread's exit empties its malloc cache, which would otherwise count as heap in use.
+//!
+//! A test crate of its own, not a module of tests/it: the measurements see the whole
+//! process, and `cargo test` runs the tests of one crate as threads of one process, where
+//! any other test allocating meanwhile would be counted (nextest's process per test
+//! would hide that, `cargo test` would not).
 
 #![cfg(target_os = "linux")]
 
@@ -22,7 +27,7 @@ use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
-#[path = "common/host.rs"]
+#[path = "it/common/host.rs"]
 mod host;
 use host::{CALLBACKS, resources};
 

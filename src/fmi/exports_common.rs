@@ -9,7 +9,7 @@
 
 use super::guard::{get, guarded, slice, slice_mut, text, with_stack};
 use super::guid::guid;
-use super::handle::{create, destroy, enter};
+use super::handle::{create, destroy};
 use super::instance::Instance;
 use super::logger::{Logger, Sink};
 use super::state_machine::{Func, State};
@@ -288,24 +288,4 @@ no_variables! {
     fmi2SetBoolean, Func::SetBoolean, *const Boolean;
     /// fmi2SetString (2.1.7): no String variables.
     fmi2SetString, Func::SetString, *const FmiString;
-}
-
-/// The messages an instance logged recently (those that passed its log filter); empty
-/// for a component that is not a live instance or is busy.
-///
-/// # Safety
-/// None beyond the FMI contract: `c` is checked against the live instances.
-#[doc(hidden)]
-pub unsafe fn last_messages(c: Component) -> Vec<String> {
-    enter(c).map(|mut s| s.instance().log.recent()).unwrap_or_default()
-}
-
-/// The instance's state-machine state (tests, diagnostics); None for a component that is
-/// not a live instance or is busy.
-///
-/// # Safety
-/// As [`last_messages`].
-#[doc(hidden)]
-pub unsafe fn instance_state(c: Component) -> Option<State> {
-    enter(c).ok().map(|mut s| s.instance().state)
 }

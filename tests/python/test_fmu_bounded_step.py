@@ -65,7 +65,7 @@ def test_a_toggle_is_discarded_at_the_toggle_time_and_a_shorter_step_from_a_save
         reached = s.getRealStatus(LAST_SUCCESSFUL_TIME)
         assert text.startswith(f"fmi2DoStep: step from {t!r} to ") and "step size collapsed" in text, text
         assert repr(reached) in text
-        # The time reached is the toggle time (tests/bounded_step.rs: measured 5.0e-10 s
+        # The time reached is the toggle time (tests/it/bounded_step.rs: measured 5.0e-10 s
         # before it; 1e-7 s asserted), where coupler and rocker are aligned (reach ~ 0).
         assert t < reached < T_STAR and T_STAR - reached < 1e-7, (reached, T_STAR)
         crank, closure, reach = s.getReal(outs)

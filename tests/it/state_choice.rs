@@ -3,22 +3,17 @@
 //! the names change, so at an equilibrium the eigenvalues are those of the body-coordinate
 //! choice (a change of state coordinates is a similarity transform of A there).
 
+use crate::common::model_files;
 use mbfmu::dae::{SimOptions, Simulator};
 use mbfmu::linearize::eigen::eigen_table;
 use mbfmu::linearize::{Candidates, linearize, select_states, select_states_among};
 use mbfmu::model::Model;
 use mbfmu::model::parse::load_str;
 
-fn model_dir() -> std::path::PathBuf {
-    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models")
-}
-
 /// Every example model, as written and (if it has one) without its `<linearization>`.
 fn example_variants() -> Vec<(String, Model)> {
     let mut out = Vec::new();
-    let mut files: Vec<_> = std::fs::read_dir(model_dir()).unwrap().map(|e| e.unwrap().path()).collect();
-    files.sort();
-    for path in files.into_iter().filter(|p| p.extension().is_some_and(|e| e == "xml")) {
+    for path in model_files() {
         let file = path.file_name().unwrap().to_string_lossy().to_string();
         let text = std::fs::read_to_string(&path).unwrap();
         out.push((file.clone(), load_str(&text, &file).unwrap()));

@@ -2,12 +2,8 @@
 //! trips, and inputs (held or linearly interpolated) drive the motion as analytic
 //! solutions say.
 
+use crate::common::model;
 use mbfmu::dae::{SimOptions, SimState, Simulator};
-use mbfmu::model::parse::load_file;
-
-fn model(name: &str) -> mbfmu::model::Model {
-    load_file(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models").join(name)).unwrap()
-}
 
 #[test]
 fn restoring_a_snapshot_reproduces_the_run_bit_for_bit() {

@@ -2,9 +2,7 @@
 
 use std::process::Command;
 
-fn mbfmu(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_mbfmu")).args(args).current_dir(env!("CARGO_MANIFEST_DIR")).output().unwrap()
-}
+use crate::common::mbfmu;
 
 #[test]
 fn linearize_prints_the_seed_blade_table_and_writes_json_npz_mat() {

@@ -3,27 +3,13 @@
 //! engine fingerprint, which changes with every source edit).
 //!
 //! After an intended change, regenerate the golden files with
-//! `MBFMU_BLESS=1 cargo test --release --test model_description` and review the diff.
+//! `MBFMU_BLESS=1 cargo test --release --test it model_description::` and review the diff.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
+use crate::common::{model_files, root};
 use mbfmu::fmi::model_description::write;
 use mbfmu::model::load_file;
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-/// Every `models/*.xml`, sorted.
-fn models() -> Vec<PathBuf> {
-    let mut v: Vec<PathBuf> = std::fs::read_dir(root().join("models"))
-        .expect("models/ exists")
-        .map(|e| e.expect("readable models/ entry").path())
-        .filter(|p| p.extension().is_some_and(|x| x == "xml"))
-        .collect();
-    v.sort();
-    v
-}
 
 /// Replace the value of attribute `name` (every occurrence) by `*`.
 fn blank_attr(xml: &str, name: &str) -> String {
@@ -59,7 +45,7 @@ fn generate(path: &Path) -> String {
 fn model_descriptions_match_the_golden_files() {
     let bless = std::env::var_os("MBFMU_BLESS").is_some_and(|v| v == "1");
     let mut failures = Vec::new();
-    let models = models();
+    let models = model_files();
     assert!(models.len() >= 7, "example models found: {}", models.len());
     for path in models {
         let stem = path.file_stem().expect("file name").to_string_lossy().into_owned();
@@ -87,7 +73,7 @@ fn model_descriptions_match_the_golden_files() {
     assert!(
         failures.is_empty(),
         "{}\n\nIf the change is intended, regenerate the golden files with\n  \
-         MBFMU_BLESS=1 cargo test --release --test model_description\nand review `git diff modelDescription/`.",
+         MBFMU_BLESS=1 cargo test --release --test it model_description::\nand review `git diff modelDescription/`.",
         failures.join("\n")
     );
 }

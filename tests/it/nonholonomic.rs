@@ -1,25 +1,18 @@
 //! Non-holonomic constraints (knife edge, rolling wheel): simulation and linearization with
 //! separate position (s0) and velocity (s1 < s0) states, against closed forms.
 
+use crate::common::lin_at_start;
 use faer::Mat;
 use mbfmu::dae::{SimOptions, Simulator};
-use mbfmu::linearize::{Linearization, linearize, select_states};
 use mbfmu::model::Model;
-use mbfmu::model::parse::load_file;
 
 fn model(name: &str, params: &[(&str, f64)]) -> Model {
-    let m = load_file(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models").join(name)).unwrap();
+    let m = crate::common::model(name);
     let mut p = m.param_values();
     for (k, v) in params {
         p[m.parameters.iter().position(|x| x.name == *k).unwrap()] = *v;
     }
     m.with_params(&p).unwrap()
-}
-
-fn lin_at_start(m: &Model) -> Linearization {
-    let mut sim = Simulator::new(m, SimOptions { tol: 1e-10, max_step: None, ..Default::default() }, 0.0).unwrap();
-    let sel = select_states(sim.system(), sim.q(), 0.0, &sim.inputs()).unwrap();
-    linearize(&mut sim, &sel, 2).unwrap()
 }
 
 #[test]

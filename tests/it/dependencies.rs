@@ -2,6 +2,8 @@
 //! lists, and every partial derivative that fmi2GetDirectionalDerivative returns outside
 //! the declared dependencies is exactly zero (every example model, moving).
 
+use crate::common::host::{CALLBACKS, resources};
+use crate::common::model_dir;
 use mbfmu::fmi::exports_common::*;
 use mbfmu::fmi::exports_cs::*;
 use mbfmu::fmi::guid::guid;
@@ -10,11 +12,6 @@ use mbfmu::fmi::types::{CO_SIMULATION, Component, Status};
 use mbfmu::model::parse::load_str;
 use std::collections::BTreeMap;
 use std::ffi::CString;
-use std::path::PathBuf;
-
-#[path = "common/host.rs"]
-mod host;
-use host::{CALLBACKS, resources};
 
 /// Two pendulums that do not touch: `a` hangs freely; `b` is driven by the input T. The
 /// input U is read by an output only.
@@ -171,8 +168,7 @@ fn undeclared_entries(text: &str, t_end: f64) -> (usize, Vec<String>) {
 
 #[test]
 fn directional_derivatives_outside_the_declared_dependencies_are_exactly_zero() {
-    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("models");
-    let mut texts: Vec<(String, String)> = std::fs::read_dir(&root)
+    let mut texts: Vec<(String, String)> = std::fs::read_dir(model_dir())
         .unwrap()
         .map(|e| e.unwrap().path())
         .filter(|p| p.extension().is_some_and(|x| x == "xml"))

@@ -1,17 +1,78 @@
-//! Helpers shared by integration tests (each test crate includes what it uses).
+//! Helpers shared by the integration tests: where the crate's files are, the `mbfmu`
+//! binary, the engine's outputs and linearization, and the engine's state-space map as an
+//! independent reference for A, B, C, D. `host` is a host of the FMU's C API.
 
-#![allow(dead_code)]
+pub mod host;
 
 use faer::linalg::solvers::Solve;
 use mbfmu::dae::init::consistent_accelerations;
 use mbfmu::dae::sparse::SparseLu;
-use mbfmu::linearize::Selection;
+use mbfmu::dae::{SimOptions, Simulator};
 use mbfmu::linearize::jets::{PositionFn, jets};
+use mbfmu::linearize::{Linearization, Selection, linearize, select_states};
 use mbfmu::mechanics::System;
 use mbfmu::mechanics::body::NQ;
 use mbfmu::mechanics::loads::{load_index, load_value};
 use mbfmu::mechanics::local::LocalCtx;
+use mbfmu::model::Model;
 use mbfmu::model::expr::{ElementRef, LoadFn};
+use mbfmu::model::parse::load_file;
+use std::path::PathBuf;
+use std::process::{Command, Output, Stdio};
+
+/// The crate's root directory.
+pub fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The example models' directory, `models/`.
+pub fn model_dir() -> PathBuf {
+    root().join("models")
+}
+
+/// Every example model file, `models/*.xml`, sorted.
+pub fn model_files() -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(model_dir())
+        .expect("models/ exists")
+        .map(|e| e.expect("readable models/ entry").path())
+        .filter(|p| p.extension().is_some_and(|x| x == "xml"))
+        .collect();
+    v.sort();
+    v
+}
+
+/// The text of the example model `models/<name>`.
+pub fn model_text(name: &str) -> String {
+    std::fs::read_to_string(model_dir().join(name)).unwrap()
+}
+
+/// The example model `models/<name>`, loaded.
+pub fn model(name: &str) -> Model {
+    load_file(&model_dir().join(name)).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Run the `mbfmu` binary with `args` in the crate's root, without stdin.
+pub fn mbfmu(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_mbfmu"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .stdin(Stdio::null())
+        .output()
+        .expect("the mbfmu binary runs")
+}
+
+/// The current value of output `name`.
+pub fn out(s: &mut Simulator, name: &str) -> f64 {
+    let i = s.output_names().iter().position(|n| n == name).unwrap_or_else(|| panic!("no output {name}"));
+    s.outputs().unwrap()[i]
+}
+
+/// The linearization of `m` at t = 0 (tolerance 1e-10, automatic states).
+pub fn lin_at_start(m: &Model) -> Linearization {
+    let mut sim = Simulator::new(m, SimOptions { tol: 1e-10, max_step: None, ..Default::default() }, 0.0).unwrap();
+    let sel = select_states(sim.system(), sim.q(), 0.0, &sim.inputs()).unwrap();
+    linearize(&mut sim, &sel, 2).unwrap()
+}
 
 /// The engine's state-space map x = (S, W), v ↦ (Ṡ, Ẇ, y) at time t: q from C(q) = 0,
 /// s(q) = S by Newton (from `q0`); u from P u + C_t = 0, ṡ(q, u) = W; u̇ and λ from the

@@ -1,22 +1,11 @@
 //! User elements (seed Eq. 7): differential states, variables (with algebraic loops),
 //! forces reading them, simulated and linearized in the same augmented system.
 
+use crate::common::{lin_at_start, model, model_text};
 use faer::Mat;
 use mbfmu::dae::{SimOptions, Simulator};
 use mbfmu::linearize::eigen::eigen_table;
-use mbfmu::linearize::{Linearization, linearize, select_states};
-use mbfmu::model::Model;
-use mbfmu::model::parse::{load_file, load_str};
-
-fn model_path(name: &str) -> std::path::PathBuf {
-    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models").join(name)
-}
-
-fn lin_at_start(m: &Model) -> Linearization {
-    let mut sim = Simulator::new(m, SimOptions { tol: 1e-10, max_step: None, ..Default::default() }, 0.0).unwrap();
-    let sel = select_states(sim.system(), sim.q(), 0.0, &sim.inputs()).unwrap();
-    linearize(&mut sim, &sel, 2).unwrap()
-}
+use mbfmu::model::parse::load_str;
 
 /// Parameters of models/cart_pendulum_pid.xml.
 struct Cart {
@@ -60,7 +49,7 @@ fn pid_cart_pendulum_matches_the_hand_linearized_closed_loop() {
     // xi' = th − r. Exact linearization: agreement to round-off; 1e-10 relative to the
     // largest entry leaves margin for the sparse LU's backward error (~1e-14·cond).
     let c = CART;
-    let lin = lin_at_start(&load_file(&model_path("cart_pendulum_pid.xml")).unwrap());
+    let lin = lin_at_start(&model("cart_pendulum_pid.xml"));
     assert_eq!(lin.states, ["x", "th", "der(x)", "der(th)", "xi"]);
     let ma = c.m * c.a;
     let jp = c.j + c.m * c.a * c.a;
@@ -109,7 +98,7 @@ fn pid_closed_loop_eigenvalues_are_the_roots_of_the_characteristic_polynomial() 
     comp[(1, 0)] = 1.0;
     comp[(2, 1)] = 1.0;
     let mut want: Vec<(f64, f64)> = comp.eigenvalues().unwrap().iter().map(|z| (z.re, z.im.abs())).collect();
-    let lin = lin_at_start(&load_file(&model_path("cart_pendulum_pid.xml")).unwrap());
+    let lin = lin_at_start(&model("cart_pendulum_pid.xml"));
     let rows = eigen_table(&lin.a).unwrap();
     let got: Vec<(f64, f64)> = rows.iter().map(|r| (r.re, r.im.abs())).collect();
     let zeros = got.iter().filter(|(re, im)| re.abs() < 1e-7 && *im < 1e-7).count();
@@ -124,13 +113,13 @@ fn pid_closed_loop_eigenvalues_are_the_roots_of_the_characteristic_polynomial() 
 #[test]
 fn implicit_and_explicit_differentials_linearize_alike() {
     // d(xi)/dt = e written implicitly (0.5·dif1(xi) − 0.5·e = 0) is the same equation.
-    let text = std::fs::read_to_string(model_path("cart_pendulum_pid.xml")).unwrap();
+    let text = model_text("cart_pendulum_pid.xml");
     let implicit = text.replace(
         r#"<differential name="xi" start="0" function="e"/>"#,
         r#"<differential name="xi" start="0" implicit="true" function="0.5*dif1(xi) - 0.5*e"/>"#,
     );
     assert_ne!(implicit, text);
-    let a = lin_at_start(&load_file(&model_path("cart_pendulum_pid.xml")).unwrap());
+    let a = lin_at_start(&model("cart_pendulum_pid.xml"));
     let b = lin_at_start(&load_str(&implicit, "implicit.xml").unwrap());
     assert_close("A", &a.a, &b.a, 1e-12);
     assert_close("B", &a.b, &b.b, 1e-12);
@@ -141,7 +130,7 @@ fn pid_loop_simulates_back_to_upright_like_its_linearization() {
     // From th0 = 0.01 rad the controller brings the pendulum back. Against the linear model
     // ẋ = A x integrated by RK4 (h = 1e-4, error ~1e-13): the nonlinear motion differs by
     // O(th0³) terms ≈ 1e-6·|th|, so |th − th_lin| < 1e-5 over 3 s.
-    let text = std::fs::read_to_string(model_path("cart_pendulum_pid.xml")).unwrap();
+    let text = model_text("cart_pendulum_pid.xml");
     let m0 = load_str(&text, "c.xml").unwrap();
     let lin = lin_at_start(&m0);
     let th0 = 0.01;

@@ -3,6 +3,7 @@
 //! (1e-12 relative), on random sparse matrices of known rank and on the example models'
 //! constraint Jacobians; and the example models keep the states chosen by Eq. 33.
 
+use crate::common::model_dir;
 use mbfmu::dae::rank::full_pivot;
 use mbfmu::dae::{SimOptions, Simulator};
 use mbfmu::linearize::select_states;
@@ -132,10 +133,6 @@ fn cq(sys: &System, q: &[f64], inputs: &[f64]) -> Vec<(usize, usize, f64)> {
         }
     }
     t
-}
-
-fn model_dir() -> std::path::PathBuf {
-    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models")
 }
 
 #[test]

@@ -1,9 +1,7 @@
 //! Exact linearization (Eq. 34) against analytic results and against central differences
 //! of the engine's own state-space equations (tests only).
 
-mod common;
-
-use common::state_space;
+use crate::common::state_space;
 use mbfmu::dae::{SimOptions, Simulator};
 use mbfmu::linearize::eigen::eigen_table;
 use mbfmu::linearize::{linearize, select_states};

@@ -1,22 +1,12 @@
 //! The engine against closed-form mechanics (issue 3's reference tests). Each test states
 //! its reference, where it comes from, and why its tolerance is what it is.
 
+use crate::common::{model, out};
 use mbfmu::dae::{SimOptions, Simulator};
 use mbfmu::model::Model;
-use mbfmu::model::parse::load_file;
-
-fn model(name: &str) -> Model {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models").join(name);
-    load_file(&path).unwrap_or_else(|e| panic!("{e}"))
-}
 
 fn sim(m: &Model, tol: f64) -> Simulator {
     Simulator::new(m, SimOptions { tol, max_step: None, ..Default::default() }, 0.0).unwrap_or_else(|e| panic!("{e}"))
-}
-
-fn out(s: &mut Simulator, name: &str) -> f64 {
-    let i = s.output_names().iter().position(|n| n == name).unwrap_or_else(|| panic!("no output {name}"));
-    s.outputs().unwrap()[i]
 }
 
 fn param(m: &Model, name: &str) -> f64 {

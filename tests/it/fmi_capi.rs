@@ -2,6 +2,8 @@
 //! the engine's own, FMU states, parameters, every refused call with its message, engine
 //! failures as fmi2Discard, and many instances.
 
+use crate::common::host::{self, CALLBACKS, free, get, last_message, messages, resources};
+use crate::common::model_text;
 use mbfmu::dae::{SimOptions, Simulator};
 use mbfmu::fmi::exports_common::*;
 use mbfmu::fmi::exports_cs::*;
@@ -11,20 +13,11 @@ use mbfmu::fmi::guid::guid;
 use mbfmu::fmi::state_machine::State;
 use mbfmu::fmi::types::{CO_SIMULATION, Component, LAST_SUCCESSFUL_TIME, MODEL_EXCHANGE, Status};
 use std::ffi::CString;
-use std::path::PathBuf;
-
-#[path = "common/host.rs"]
-mod host;
-use host::{CALLBACKS, resources};
-
-fn model_text(name: &str) -> String {
-    std::fs::read_to_string(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("models").join(name)).unwrap()
-}
 
 fn instantiate_with(text: &str, fmu_type: i32, guid_s: &str) -> Component {
     let (name, g, uri) = (c"inst", CString::new(guid_s).unwrap(), resources(text, "capi").1);
-    // SAFETY: valid NUL-terminated strings and callbacks.
-    unsafe { fmi2Instantiate(name.as_ptr(), fmu_type, g.as_ptr(), uri.as_ptr(), &CALLBACKS, 0, 1) }
+    // SAFETY: valid NUL-terminated strings; the host's callbacks with a recording logger.
+    unsafe { host::instantiate(name.as_ptr(), fmu_type, g.as_ptr(), uri.as_ptr(), 0, 1) }
 }
 
 fn instantiate(text: &str) -> Component {
@@ -48,33 +41,12 @@ fn initialized(text: &str, tol: f64, params: &[(u32, f64)]) -> Component {
     c
 }
 
-fn get(c: Component, vrs: &[u32]) -> Vec<f64> {
-    let mut v = vec![0.0; vrs.len()];
-    // SAFETY: arrays of vrs.len() elements.
-    assert_eq!(unsafe { fmi2GetReal(c, vrs.as_ptr(), vrs.len(), v.as_mut_ptr()) }, Status::Ok, "{:?}", msgs(c));
-    v
-}
-
-fn msgs(c: Component) -> Vec<String> {
-    // SAFETY: a live instance.
-    unsafe { last_messages(c) }
-}
-
-fn last_msg(c: Component) -> String {
-    msgs(c).pop().unwrap_or_default()
-}
-
-fn free(c: Component) {
-    // SAFETY: a live instance, freed once.
-    unsafe { fmi2FreeInstance(c) }
-}
-
 /// Steps of `h` from `t0`, n times; the time accumulates as a host's does.
 fn step(c: Component, t0: f64, h: f64, n: usize) -> f64 {
     let mut t = t0;
     for _ in 0..n {
         // SAFETY: a live instance.
-        assert_eq!(unsafe { fmi2DoStep(c, t, h, 1) }, Status::Ok, "{:?}", msgs(c));
+        assert_eq!(unsafe { fmi2DoStep(c, t, h, 1) }, Status::Ok, "{:?}", messages(c));
         t += h;
     }
     t
@@ -139,7 +111,7 @@ fn rewinding_through_fmu_states_and_serialized_bytes_reproduces_outputs_bit_for_
         let mut bytes = vec![0 as libc::c_char; size];
         assert_eq!(fmi2SerializeFMUstate(c, s, bytes.as_mut_ptr(), size), Status::Ok);
         assert_eq!(fmi2SerializeFMUstate(c, s, bytes.as_mut_ptr(), size - 1), Status::Error);
-        assert!(last_msg(c).contains("fmi2SerializeFMUstate"));
+        assert!(last_message(c).contains("fmi2SerializeFMUstate"));
         assert_eq!(fmi2FreeFMUstate(c, &mut s), Status::Ok);
         assert!(s.is_null());
 
@@ -147,18 +119,18 @@ fn rewinding_through_fmu_states_and_serialized_bytes_reproduces_outputs_bit_for_
         let d = instantiate(&text);
         let mut s2: *mut libc::c_void = std::ptr::null_mut();
         assert_eq!(fmi2DeSerializeFMUstate(d, bytes.as_ptr(), size, &mut s2), Status::Ok);
-        assert_eq!(fmi2SetFMUstate(d, s2), Status::Ok, "{:?}", msgs(d));
-        assert_eq!(instance_state(d), Some(State::StepComplete));
+        assert_eq!(fmi2SetFMUstate(d, s2), Status::Ok, "{:?}", messages(d));
+        assert_eq!(host::state(d), Some(State::StepComplete));
         assert_eq!(step(d, t1, 0.1, 5), t2);
         assert_eq!(get(d, &outs), first, "new instance, deserialized");
         assert_eq!(fmi2FreeFMUstate(d, &mut s2), Status::Ok);
 
         // Bytes of another model are refused by name.
         assert_eq!(fmi2DeSerializeFMUstate(d, b"garbage".as_ptr().cast(), 7, &mut s2), Status::Error);
-        assert!(last_msg(d).contains("fmi2DeSerializeFMUstate"));
+        assert!(last_message(d).contains("fmi2DeSerializeFMUstate"));
         let p = initialized(&model_text("pendulum.xml"), 1e-8, &[]);
         assert_eq!(fmi2DeSerializeFMUstate(p, bytes.as_ptr(), size, &mut s2), Status::Error);
-        assert!(last_msg(p).contains("belongs to"), "{:?}", msgs(p));
+        assert!(last_message(p).contains("belongs to"), "{:?}", messages(p));
         for x in [c, d, p] {
             free(x);
         }
@@ -179,7 +151,7 @@ fn a_pendulum_length_set_before_initialization_changes_the_motion_and_after_is_r
     assert_ne!(get(c, &PENDULUM_OUTPUTS), direct(&text, None, 1e-8, 0.05, 20));
     // SAFETY: a live instance, one-element arrays.
     assert_eq!(unsafe { fmi2SetReal(c, &L_VR, 1, &2.0) }, Status::Error);
-    let m = last_msg(c);
+    let m = last_message(c);
     assert!(m.contains("fmi2SetReal") && m.contains("'L'") && m.contains("after initialization"), "{m}");
     assert_eq!(get(c, &[L_VR]), [1.0], "refused value not applied");
     free(c);
@@ -199,7 +171,7 @@ fn outputs_read_in_initialization_mode_follow_the_parameters_set_there() {
         assert_eq!(fmi2ExitInitializationMode(c), Status::Ok);
         // stopTime 1 is enforced.
         assert_eq!(fmi2DoStep(c, 0.0, 1.5, 1), Status::Error);
-        assert!(last_msg(c).contains("stopTime"));
+        assert!(last_message(c).contains("stopTime"));
         assert_eq!(fmi2DoStep(c, 0.0, 1.0, 1), Status::Ok);
     }
     free(c);
@@ -208,7 +180,7 @@ fn outputs_read_in_initialization_mode_follow_the_parameters_set_there() {
 /// Expect `status` and a last message naming `func` (and containing `what`), then a valid call.
 fn refused(c: Component, got: Status, want: Status, func: &str, what: &str) {
     assert_eq!(got, want, "{func}");
-    let m = last_msg(c);
+    let m = last_message(c);
     assert!(m.starts_with(func) && m.contains(what), "{func}: message {m:?}");
     get(c, &[0]);
 }
@@ -222,9 +194,9 @@ fn every_refused_call_returns_its_status_names_the_function_and_leaves_the_insta
     // SAFETY: a live instance; NULL pointers are what is tested, with n > 0 they are refused.
     unsafe {
         assert_eq!(fmi2DoStep(c, 0.0, 0.1, 1), Status::Error);
-        assert_eq!(last_msg(c), "fmi2DoStep: not allowed in state Instantiated");
+        assert_eq!(last_message(c), "fmi2DoStep: not allowed in state Instantiated");
         assert_eq!(fmi2SetupExperiment(c, 1, -1.0, 0.0, 0, 0.0), Status::Error);
-        assert!(last_msg(c).starts_with("fmi2SetupExperiment: tolerance -1"));
+        assert!(last_message(c).starts_with("fmi2SetupExperiment: tolerance -1"));
         assert_eq!(fmi2SetupExperiment(c, 1, 1e-8, 0.0, 0, 0.0), Status::Ok);
         assert_eq!(fmi2EnterInitializationMode(c), Status::Ok);
         assert_eq!(fmi2ExitInitializationMode(c), Status::Ok);
@@ -265,7 +237,7 @@ fn every_refused_call_returns_its_status_names_the_function_and_leaves_the_insta
         assert_eq!(fmi2DoStep(std::ptr::null_mut(), 0.0, 0.1, 1), Status::Error);
         assert_eq!(fmi2GetReal(std::ptr::null_mut(), &0, 1, v.as_mut_ptr()), Status::Error);
         assert_eq!(fmi2Reset(c), Status::Ok);
-        assert_eq!(instance_state(c), Some(State::Instantiated));
+        assert_eq!(host::state(c), Some(State::Instantiated));
     }
     free(c);
 }
@@ -305,10 +277,10 @@ fn a_step_the_engine_cannot_finish_is_discarded_at_the_time_it_reached() {
     // SAFETY: a live instance, valid out-pointers.
     unsafe {
         assert_eq!(fmi2DoStep(c, 0.5, 1.0, 1), Status::Discard);
-        let m = msgs(c);
+        let m = messages(c);
         assert!(m.iter().any(|s| s.starts_with("fmi2DoStep: step from 0.5 to 1.5 stopped at")), "{m:?}");
         assert_eq!(m.last().unwrap(), "fmi2DoStep: state StepComplete -> StepFailed", "logEvents");
-        assert_eq!(instance_state(c), Some(State::StepFailed));
+        assert_eq!(host::state(c), Some(State::StepFailed));
         assert_eq!(fmi2GetRealStatus(c, LAST_SUCCESSFUL_TIME, &mut last), Status::Ok);
         assert!(last > 0.5 && last <= 1.0, "reached {last}");
         let mut st = Status::Ok;
@@ -340,7 +312,7 @@ fn held_and_ramped_inputs_drive_a_rotor_as_the_closed_form_says() {
         step(c, 0.0, 1.0, 1);
         assert!((get(c, &[1])[0] - 4.0).abs() < 1e-12);
         assert_eq!(fmi2SetRealInputDerivatives(c, &0, 1, &2, &3.0), Status::Error);
-        assert!(last_msg(c).contains("order 2"));
+        assert!(last_message(c).contains("order 2"));
         assert_eq!(fmi2SetRealInputDerivatives(c, &0, 1, &1, &3.0), Status::Ok);
         step(c, 1.0, 1.0, 1);
         assert!((get(c, &[1])[0] - 11.0).abs() < 1e-12);
@@ -380,16 +352,14 @@ fn a_panic_inside_an_export_becomes_fatal_when_the_engine_may_be_corrupt_and_err
     let text = model_text("pendulum.xml");
     let c = initialized(&text, 1e-6, &[]);
     assert_eq!(guarded(c, Func::GetReal, |_| panic!("boom")), Status::Error);
-    assert_eq!(last_msg(c), "fmi2GetReal: internal error (panic): boom");
-    // SAFETY: a live instance.
-    assert_eq!(unsafe { instance_state(c) }, Some(State::Error));
+    assert_eq!(last_message(c), "fmi2GetReal: internal error (panic): boom");
+    assert_eq!(host::state(c), Some(State::Error));
     // SAFETY: a live instance.
     assert_eq!(unsafe { fmi2DoStep(c, 0.0, 0.1, 1) }, Status::Error, "no stepping in state Error");
     let d = initialized(&text, 1e-6, &[]);
     assert_eq!(guarded(d, Func::DoStep, |_| panic!("boom {}", 2)), Status::Fatal);
-    assert_eq!(last_msg(d), "fmi2DoStep: internal error (panic): boom 2");
-    // SAFETY: a live instance.
-    assert_eq!(unsafe { instance_state(d) }, Some(State::Fatal));
+    assert_eq!(last_message(d), "fmi2DoStep: internal error (panic): boom 2");
+    assert_eq!(host::state(d), Some(State::Fatal));
     free(c);
     free(d);
 }
@@ -425,7 +395,7 @@ fn full_run(text: &str, knowns: &[u32], unknowns: &[u32]) -> Vec<f64> {
         for &k in knowns {
             let mut col = vec![0.0; unknowns.len()];
             let st = fmi2GetDirectionalDerivative(c, unknowns.as_ptr(), unknowns.len(), &k, 1, &1.0, col.as_mut_ptr());
-            assert_eq!(st, Status::Ok, "{:?}", msgs(c));
+            assert_eq!(st, Status::Ok, "{:?}", messages(c));
             out.extend(col);
         }
     }
@@ -514,7 +484,7 @@ fn a_serialized_state_with_any_byte_changed_or_cut_is_refused() {
                 assert!(back.is_null());
             }
         }
-        assert!(last_msg(c).contains("corrupted") || last_msg(c).contains("not a serialized state"));
+        assert!(last_message(c).contains("corrupted") || last_message(c).contains("not a serialized state"));
         for len in [0, 8, n / 2, n - 1] {
             assert_eq!(fmi2DeSerializeFMUstate(c, bytes.as_ptr(), len, &mut back), Status::Error, "length {len}");
         }

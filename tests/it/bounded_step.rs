@@ -3,6 +3,8 @@
 //! a step-size collapse at a lock-up) returns fmi2Discard with fmi2LastSuccessfulTime =
 //! the time reached; restoring an FMU state lets the host retry or continue.
 
+use crate::common::host::{self, free, get, messages, resources};
+use crate::common::{model_text, root};
 use mbfmu::dae::{DEFAULT_MAX_STEPS, SimOptions, Simulator};
 use mbfmu::fmi::exports_common::*;
 use mbfmu::fmi::exports_cs::*;
@@ -15,23 +17,10 @@ use mbfmu::fmi::variables::{MAX_STEPS_NAME, variables};
 use mbfmu::linearize::StateLayout;
 use mbfmu::model::parse::load_str;
 use std::ffi::CString;
-use std::path::PathBuf;
 use std::time::Instant;
-
-#[path = "common/host.rs"]
-mod host;
-use host::{CALLBACKS, resources};
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
 
 fn toggle_text() -> String {
     std::fs::read_to_string(root().join("tests/models/fourbar_toggle.xml")).unwrap()
-}
-
-fn model_text(name: &str) -> String {
-    std::fs::read_to_string(root().join("models").join(name)).unwrap()
 }
 
 /// Toggle geometry of tests/models/fourbar_toggle.xml: crank a, coupler b, rocker c,
@@ -67,8 +56,9 @@ fn angle_diff(a: f64, b: f64) -> f64 {
 
 fn instantiate(text: &str) -> Component {
     let (g, uri) = (CString::new(guid(text)).unwrap(), resources(text, "bounded").1);
-    // SAFETY: valid NUL-terminated strings and callbacks; logging on (every category).
-    let c = unsafe { fmi2Instantiate(c"bounded".as_ptr(), CO_SIMULATION, g.as_ptr(), uri.as_ptr(), &CALLBACKS, 0, 1) };
+    // SAFETY: valid NUL-terminated strings; the host's callbacks with a recording logger;
+    // logging on (every category).
+    let c = unsafe { host::instantiate(c"bounded".as_ptr(), CO_SIMULATION, g.as_ptr(), uri.as_ptr(), 0, 1) };
     assert!(!c.is_null());
     c
 }
@@ -79,7 +69,7 @@ fn initialize(c: Component, tol: f64) {
     unsafe {
         assert_eq!(fmi2SetupExperiment(c, 1, tol, 0.0, 0, 0.0), Status::Ok);
         assert_eq!(fmi2EnterInitializationMode(c), Status::Ok);
-        assert_eq!(fmi2ExitInitializationMode(c), Status::Ok, "{:?}", msgs(c));
+        assert_eq!(fmi2ExitInitializationMode(c), Status::Ok, "{:?}", messages(c));
     }
 }
 
@@ -93,17 +83,10 @@ fn vr(text: &str, name: &str) -> u32 {
         .value_reference
 }
 
-fn get(c: Component, vrs: &[u32]) -> Vec<f64> {
-    let mut v = vec![0.0; vrs.len()];
-    // SAFETY: arrays of vrs.len() elements.
-    assert_eq!(unsafe { fmi2GetReal(c, vrs.as_ptr(), vrs.len(), v.as_mut_ptr()) }, Status::Ok, "{:?}", msgs(c));
-    v
-}
-
 fn get_int(c: Component, vr: u32) -> i32 {
     let mut v = 0;
     // SAFETY: one-element arrays.
-    assert_eq!(unsafe { fmi2GetInteger(c, &vr, 1, &mut v) }, Status::Ok, "{:?}", msgs(c));
+    assert_eq!(unsafe { fmi2GetInteger(c, &vr, 1, &mut v) }, Status::Ok, "{:?}", messages(c));
     v
 }
 
@@ -117,16 +100,6 @@ fn last_time(c: Component) -> f64 {
     // SAFETY: a live instance, a valid out-pointer.
     assert_eq!(unsafe { fmi2GetRealStatus(c, LAST_SUCCESSFUL_TIME, &mut t) }, Status::Ok);
     t
-}
-
-fn msgs(c: Component) -> Vec<String> {
-    // SAFETY: a live instance.
-    unsafe { last_messages(c) }
-}
-
-fn free(c: Component) {
-    // SAFETY: a live instance, freed once.
-    unsafe { fmi2FreeInstance(c) }
 }
 
 #[test]
@@ -202,7 +175,7 @@ fn a_four_bar_driven_into_its_toggle_is_discarded_there_and_a_shorter_step_from_
     unsafe {
         let mut t = 0.0;
         for k in 1..=19 {
-            assert_eq!(fmi2DoStep(c, t, k as f64 * 0.1 - t, 1), Status::Ok, "{:?}", msgs(c));
+            assert_eq!(fmi2DoStep(c, t, k as f64 * 0.1 - t, 1), Status::Ok, "{:?}", messages(c));
             t = k as f64 * 0.1;
         }
         assert_eq!(fmi2GetFMUstate(c, &mut s), Status::Ok);
@@ -210,8 +183,8 @@ fn a_four_bar_driven_into_its_toggle_is_discarded_there_and_a_shorter_step_from_
         let started = Instant::now();
         assert_eq!(fmi2DoStep(c, t, 0.2, 1), Status::Discard);
         let took = started.elapsed().as_secs_f64();
-        assert_eq!(instance_state(c), Some(State::StepFailed));
-        let m = msgs(c);
+        assert_eq!(host::state(c), Some(State::StepFailed));
+        let m = messages(c);
         let discard = m.iter().find(|s| s.starts_with("fmi2DoStep: step from ")).unwrap();
         assert!(discard.contains(&format!("stopped at {}: step size collapsed", last_time(c))), "{discard}");
         assert!(discard.contains("toggle"), "{discard}");
@@ -233,10 +206,10 @@ fn a_four_bar_driven_into_its_toggle_is_discarded_there_and_a_shorter_step_from_
         assert_eq!(fmi2DoStep(c, reached, 0.01, 1), Status::Error, "no step after a discard");
 
         // Back before the toggle, a step that stays before it.
-        assert_eq!(fmi2SetFMUstate(c, s), Status::Ok, "{:?}", msgs(c));
-        assert_eq!(instance_state(c), Some(State::StepComplete));
+        assert_eq!(fmi2SetFMUstate(c, s), Status::Ok, "{:?}", messages(c));
+        assert_eq!(host::state(c), Some(State::StepComplete));
         assert_eq!(last_time(c), t);
-        assert_eq!(fmi2DoStep(c, t, 0.1, 1), Status::Ok, "{:?}", msgs(c));
+        assert_eq!(fmi2DoStep(c, t, 0.1, 1), Status::Ok, "{:?}", messages(c));
         assert_eq!(last_time(c), t + 0.1);
         // Constraints hold at t = 2.0, 6.3 ms before the toggle: the crank follows its
         // drive and the rocker sits where the loop closes (measured: crank exact, closure
@@ -271,7 +244,7 @@ fn a_runaway_step_returns_discard_at_solver_max_steps_and_the_host_continues_fro
         let took = started.elapsed().as_secs_f64();
         let reached = last_time(c);
         assert!(reached > 0.0 && reached < 1e6, "{reached}");
-        let m = msgs(c);
+        let m = messages(c);
         let discard = m.iter().find(|s| s.starts_with("fmi2DoStep: step from 0 to 1000000 stopped at ")).unwrap();
         assert!(discard.contains("step limit reached: 200 integrator steps"), "{discard}");
         assert!(discard.contains("raise the limit (FMU parameter solver.maxSteps"), "{discard}");
@@ -285,9 +258,9 @@ fn a_runaway_step_returns_discard_at_solver_max_steps_and_the_host_continues_fro
         let mut s: *mut libc::c_void = std::ptr::null_mut();
         assert_eq!(fmi2GetFMUstate(c, &mut s), Status::Ok);
         assert_eq!(fmi2SetFMUstate(c, s), Status::Ok);
-        assert_eq!(instance_state(c), Some(State::StepComplete));
+        assert_eq!(host::state(c), Some(State::StepComplete));
         assert_eq!(get_int(c, max), 200, "the state carries solver.maxSteps");
-        assert_eq!(fmi2DoStep(c, reached, 0.01, 1), Status::Ok, "{:?}", msgs(c));
+        assert_eq!(fmi2DoStep(c, reached, 0.01, 1), Status::Ok, "{:?}", messages(c));
         assert_eq!(last_time(c), reached + 0.01);
         assert!(get(c, &[vr(&text, "angle")])[0].is_finite());
         assert_eq!(fmi2FreeFMUstate(c, &mut s), Status::Ok);
@@ -307,7 +280,7 @@ fn solver_max_steps_refuses_values_below_one_and_travels_with_the_fmu_state() {
         assert_eq!(get_int(c, max), DEFAULT_MAX_STEPS as i32, "readable in initialization mode");
         for bad in [0, -3, i32::MIN] {
             assert_eq!(set_int(c, max, bad), Status::Error);
-            let m = msgs(c).pop().unwrap();
+            let m = messages(c).pop().unwrap();
             assert!(m.starts_with(&format!("fmi2SetInteger: value {bad} for 'solver.maxSteps' (vr {max})")), "{m}");
             assert_eq!(get_int(c, max), DEFAULT_MAX_STEPS as i32, "refused value not applied");
         }
@@ -318,13 +291,13 @@ fn solver_max_steps_refuses_values_below_one_and_travels_with_the_fmu_state() {
         // It is an Integer; the model's variables are Real.
         let mut x = 0.0;
         assert_eq!(fmi2GetReal(c, &max, 1, &mut x), Status::Error);
-        assert!(msgs(c).pop().unwrap().contains("is an Integer variable"));
+        assert!(messages(c).pop().unwrap().contains("is an Integer variable"));
         assert_eq!(fmi2SetReal(c, &max, 1, &5.0), Status::Error);
         let mut i = 0;
         assert_eq!(fmi2GetInteger(c, &0, 1, &mut i), Status::Error);
-        assert!(msgs(c).pop().unwrap().contains("'m' (vr 0) is a Real variable"));
+        assert!(messages(c).pop().unwrap().contains("'m' (vr 0) is a Real variable"));
         assert_eq!(fmi2GetInteger(c, &(max + 1), 1, &mut i), Status::Error);
-        assert!(msgs(c).pop().unwrap().contains(&format!("unknown value reference {}", max + 1)));
+        assert!(messages(c).pop().unwrap().contains(&format!("unknown value reference {}", max + 1)));
 
         // Still usable: set in initialization mode, initialized, stepped.
         assert_eq!(set_int(c, max, 500), Status::Ok);
@@ -345,15 +318,15 @@ fn solver_max_steps_refuses_values_below_one_and_travels_with_the_fmu_state() {
         let d = instantiate(&text);
         let mut s2: *mut libc::c_void = std::ptr::null_mut();
         assert_eq!(fmi2DeSerializeFMUstate(d, bytes.as_ptr(), size, &mut s2), Status::Ok);
-        assert_eq!(fmi2SetFMUstate(d, s2), Status::Ok, "{:?}", msgs(d));
+        assert_eq!(fmi2SetFMUstate(d, s2), Status::Ok, "{:?}", messages(d));
         assert_eq!(get_int(d, max), 500);
         // A limit of one attempt cannot cross 1 s (half a swing) of the pendulum: discard.
         assert_eq!(set_int(d, max, 1), Status::Ok);
         assert_eq!(fmi2DoStep(d, 0.1, 1.0, 1), Status::Discard);
-        assert!(msgs(d).iter().any(|m| m.contains("step limit reached: 1 integrator steps")), "{:?}", msgs(d));
+        assert!(messages(d).iter().any(|m| m.contains("step limit reached: 1 integrator steps")), "{:?}", messages(d));
         assert_eq!(fmi2SetFMUstate(d, s2), Status::Ok);
         assert_eq!(get_int(d, max), 500);
-        assert_eq!(fmi2DoStep(d, 0.1, 0.1, 1), Status::Ok, "{:?}", msgs(d));
+        assert_eq!(fmi2DoStep(d, 0.1, 0.1, 1), Status::Ok, "{:?}", messages(d));
         // fmi2Reset restores the default.
         assert_eq!(fmi2Reset(d), Status::Ok);
         assert_eq!(fmi2EnterInitializationMode(d), Status::Ok);

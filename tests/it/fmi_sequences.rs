@@ -9,6 +9,8 @@
 //! `MBFMU_FMI_SEQUENCES` (default 300, what CI runs) sets how many sequences;
 //! `MBFMU_FMI_SEED` the base seed; `bench/fmi_sequences.sh` runs thousands.
 
+use crate::common::host::{self, CALLBACKS, resources};
+use crate::common::model_files;
 use mbfmu::fmi::exports_common::*;
 use mbfmu::fmi::exports_cs::*;
 use mbfmu::fmi::exports_me::*;
@@ -20,12 +22,7 @@ use mbfmu::fmi::types::{
 use mbfmu::fmi::variables::{Causality, variables};
 use std::collections::BTreeMap;
 use std::ffi::CString;
-use std::path::PathBuf;
 use std::time::{Duration, Instant};
-
-#[path = "common/host.rs"]
-mod host;
-use host::{CALLBACKS, resources};
 
 /// The longest any single call may take. A doStep is bounded by `solver.maxSteps`; the
 /// sequences set it to at most [`MAX_STEPS`] (or leave the default), so on these models a
@@ -82,11 +79,7 @@ struct Model {
 }
 
 fn models() -> Vec<Model> {
-    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    let mut files: Vec<PathBuf> = std::fs::read_dir(root.join("models")).unwrap().map(|e| e.unwrap().path()).collect();
-    files.retain(|p| p.extension().is_some_and(|e| e == "xml"));
-    files.sort();
-    files
+    model_files()
         .iter()
         .map(|path| {
             let text = std::fs::read_to_string(path).unwrap();
@@ -142,8 +135,9 @@ impl Tally {
         if dt > CALL_LIMIT {
             self.failures.push(format!("{what} took {dt:?}"));
         }
-        // SAFETY: last_messages checks the component against the live instances.
-        if let Some(m) = unsafe { last_messages(c) }.iter().find(|m| m.contains("internal error (panic)")) {
+        // What the instance told its logger (every message that passed its log filter, as
+        // a panic's fmi2Error or fmi2Fatal always does).
+        if let Some(m) = host::messages(c).iter().find(|m| m.contains("internal error (panic)")) {
             self.failures.push(format!("{what}: {m}"));
         }
         s
@@ -193,8 +187,9 @@ fn sequence(r: &mut Rng, m: &Model, other: &Model, tally: &mut Tally) {
     let bad_guid = CString::new("{00000000-0000-0000-0000-000000000000}").unwrap();
     let guid = if r.chance(0.03) { &bad_guid } else { &m.guid };
     let fmu_type = if r.chance(0.03) { r.pick(&[0, 7, -1]) } else { CO_SIMULATION };
-    // SAFETY: valid strings and callbacks (the wrong GUID and type are refused values).
-    let c = unsafe { fmi2Instantiate(name.as_ptr(), fmu_type, guid.as_ptr(), m.uri.as_ptr(), &CALLBACKS, 0, 1) };
+    // SAFETY: valid strings, and the host's callbacks with a recording logger (the wrong
+    // GUID and type are refused values).
+    let c = unsafe { host::instantiate(name.as_ptr(), fmu_type, guid.as_ptr(), m.uri.as_ptr(), 0, 1) };
     if c.is_null() {
         return;
     }
@@ -428,7 +423,7 @@ fn sequence(r: &mut Rng, m: &Model, other: &Model, tally: &mut Tally) {
                 }
                 28 if r.chance(0.3) => {
                     // Free mid-sequence: every later call must be refused, not crash.
-                    fmi2FreeInstance(c);
+                    host::free(c);
                     alive = false;
                 }
                 _ => {
@@ -451,7 +446,7 @@ fn sequence(r: &mut Rng, m: &Model, other: &Model, tally: &mut Tally) {
     // SAFETY: live instances (or already freed: refused); `foreign` belongs to `d`.
     unsafe {
         if alive {
-            fmi2FreeInstance(c);
+            host::free(c);
         }
         if !d.is_null() {
             fmi2FreeFMUstate(d, &mut foreign);

@@ -4,9 +4,7 @@
 //! `mechanics::loads` against central differences of its values; and the physical values
 //! of a pendulum's hinge force (static weight, centripetal and tangential parts).
 
-mod common;
-
-use common::state_space;
+use crate::common::state_space;
 use mbfmu::dae::{SimOptions, Simulator};
 use mbfmu::linearize::{linearize, select_states};
 use mbfmu::mechanics::body::NQ;

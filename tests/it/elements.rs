@@ -1,17 +1,13 @@
 //! Each joint type and force element against an analytic motion or a second, independent
 //! way of writing the same model.
 
+use crate::common::out;
 use mbfmu::dae::{SimOptions, Simulator};
 use mbfmu::model::parse::load_str;
 
 fn sim(xml: &str, tol: f64) -> Simulator {
     let m = load_str(xml, "t.xml").unwrap_or_else(|e| panic!("{e}"));
     Simulator::new(&m, SimOptions { tol, max_step: None, ..Default::default() }, 0.0).unwrap_or_else(|e| panic!("{e}"))
-}
-
-fn out(s: &mut Simulator, name: &str) -> f64 {
-    let i = s.output_names().iter().position(|n| n == name).unwrap_or_else(|| panic!("no output {name}"));
-    s.outputs().unwrap()[i]
 }
 
 /// A body on a joint whose z axis is ground z, with gravity g_z, initial axial speed and spin.

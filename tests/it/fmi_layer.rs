@@ -13,9 +13,7 @@ use std::ffi::CString;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
-#[path = "common/host.rs"]
-mod host;
-use host::{CALLBACKS, resources};
+use crate::common::host::{CALLBACKS, resources};
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))

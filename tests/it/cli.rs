@@ -2,18 +2,10 @@
 //! example models (each checks and simulates).
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::process::Output;
 
+use crate::common::mbfmu;
 use mbfmu::model::load_file;
-
-fn mbfmu(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_mbfmu"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .stdin(Stdio::null())
-        .output()
-        .expect("the mbfmu binary runs")
-}
 
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()

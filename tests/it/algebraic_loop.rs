@@ -3,8 +3,7 @@
 //! The reaction depends on the acceleration, which depends on the friction torque: solved
 //! with the equations of motion (Newton, exact Jacobian through the load's derivatives).
 
-mod common;
-
+use crate::common;
 use mbfmu::dae::{SimOptions, Simulator};
 use mbfmu::linearize::{linearize, select_states};
 use mbfmu::model::parse::load_str;

@@ -1,0 +1,42 @@
+//! The integration tests of mbfmu, in one crate: one module per area (the former
+//! `tests/<area>.rs` files) and the helpers they share in `common` (engine-side) and
+//! `common::host` (a host of the FMU's C API). One crate links the library once instead
+//! of once per file. Select a module with a filter: `cargo test --release --test it
+//! fmi_sequences::`, `cargo nextest run --release -E 'test(/^fmi_capi::/)'`.
+//!
+//! Only tests/memory_rss.rs is a crate of its own: it measures the whole process's
+//! resident set and heap, which the other tests' threads would disturb under `cargo test`.
+
+mod common;
+
+mod algebraic_loop;
+mod assembly;
+mod bicycle_benchmark;
+mod bounded_step;
+mod bushing;
+mod cli;
+mod cli_linearize;
+mod dependencies;
+mod elements;
+mod expr_derivatives;
+mod fmi_capi;
+mod fmi_layer;
+mod fmi_sequences;
+mod jacobians;
+mod linearize;
+mod linearize_loads;
+mod linearize_seed;
+mod malformed;
+mod memory_valgrind;
+mod model_description;
+mod models_parse;
+mod nonholonomic;
+mod pack;
+mod physics;
+mod physics_pendulum;
+mod rank;
+mod redundant;
+mod sparse_solve;
+mod state;
+mod state_choice;
+mod user_elements;
