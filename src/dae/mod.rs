@@ -4,9 +4,12 @@
 pub mod counts;
 pub mod equations;
 pub mod init;
+pub mod jacobian;
+pub mod layout;
 pub mod radau;
 mod radau_tableau;
 pub mod rank;
+pub mod residual;
 mod simulator;
 pub mod sparse;
 

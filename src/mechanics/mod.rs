@@ -5,13 +5,16 @@
 
 pub mod body;
 pub mod components;
+pub mod constraint_jacobian;
 pub mod constraints;
 pub mod forces;
 pub mod joint_coords;
 pub mod kernels;
 pub mod loads;
 pub mod local;
+pub mod mass;
 pub mod nonholonomic;
+pub mod nonholonomic_jacobian;
 pub mod system;
 pub mod user;
 
