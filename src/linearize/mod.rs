@@ -5,6 +5,7 @@
 pub mod augmented;
 pub mod candidates;
 pub mod eigen;
+pub mod eq34;
 pub mod jets;
 pub mod layout;
 pub mod outputs;

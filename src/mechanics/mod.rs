@@ -23,10 +23,15 @@
 //! - [`loads`]: element loads `fx(name)` … and their exact gradients.
 //! - [`external_values`]: [`System::ext`], the external values at a state.
 //! - [`components`]: connected components of the mechanism.
+//! - [`mass`]: the mass matrix M(q) (Eq. 1a), body by body.
+//! - [`constraint_jacobian`]: the one assembly of C_q, its transpose, the velocity form P
+//!   and the filter of redundant rows (Eq. 1b–1c).
+//! - [`nonholonomic_jacobian`]: B and γ of the non-holonomic rows (Eq. 7).
 
 pub mod body;
 pub mod components;
 pub mod constraint_equations;
+pub mod constraint_jacobian;
 pub mod constraints;
 pub mod external;
 pub mod external_values;
@@ -38,8 +43,10 @@ pub mod kernels;
 pub mod load_components;
 pub mod loads;
 pub mod local;
+pub mod mass;
 pub mod nonholonomic;
 pub mod nonholonomic_equations;
+pub mod nonholonomic_jacobian;
 pub mod system;
 pub mod user;
 pub mod user_rows;

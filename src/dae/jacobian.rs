@@ -1,0 +1,296 @@
+//! J = ∂f/∂y of the stabilized index-2 system (see [`super::equations`]), exact, from the
+//! element kernels; one function per block of equations, pushed in this order.
+
+use super::layout::Layout;
+use super::sparse::Triplets;
+use crate::mechanics::System;
+use crate::mechanics::body::{NQ, h_angular, qdot};
+use crate::mechanics::constraint_jacobian::{global_column, p_row};
+use crate::mechanics::kernels::{
+    constraint_second, dhtw_dq, dqdot_dq, force_ext_jacobian, force_jacobian, gather, gyroscopic, nonholonomic_second,
+    user_jacobian,
+};
+use crate::mechanics::loads::{LoadGradient, LoadTerm, NLOAD, load_gradient};
+use crate::mechanics::mass::body_mass_entries;
+
+/// The point J is taken at.
+struct At<'a> {
+    sys: &'a System,
+    lay: Layout,
+    t: f64,
+    y: &'a [f64],
+    q: &'a [f64],
+    u: &'a [f64],
+    /// External values [inputs; Z; L] at y.
+    ext: &'a [f64],
+}
+
+/// J = ∂f/∂y, exact except for the term ∂(C_qᵀμ)/∂q, which vanishes on the solution (μ = 0).
+pub fn jacobian(sys: &System, lay: Layout, t: f64, y: &[f64], inputs: &[f64], jac: &mut Triplets) {
+    let ext = lay.ext(sys, inputs, y, t);
+    let at = At { sys, lay, t, y, q: &y[lay.q_range()], u: &y[lay.u_range()], ext: &ext };
+    let lc = LoadChain::new(sys, lay, y, t, &ext);
+    user_rows(&at, &lc, jac);
+    kinematic_rows(&at, jac);
+    nonholonomic_rows(&at, jac);
+    force_rows(&at, &lc, jac);
+    constraint_rows(&at, jac);
+    acceleration_rows(&at, jac);
+}
+
+/// ∂/∂y of X' = Ẋ and of the user rows (Eq. 7a–7b), loads chained through [`LoadChain`].
+fn user_rows(at: &At, lc: &LoadChain, jac: &mut Triplets) {
+    let (sys, lay) = (at.sys, at.lay);
+    let (nz, nu, ni) = (lay.z(), lay.u(), sys.ni());
+    for i in 0..lay.nx {
+        jac.push(nz + i, nz + lay.nx + i, 1.0);
+    }
+    for (k, ue) in sys.user.iter().enumerate() {
+        let row = nz + lay.nx + k;
+        let uj = user_jacobian(sys, ue, at.q, at.u, at.t, at.ext);
+        let nql = NQ * ue.bodies.len();
+        for a in 0..nql {
+            let g = global_column(&ue.bodies, a);
+            jac.push(row, g, uj.dqu[a]);
+            jac.push(row, nu + g, uj.dqu[nql + a]);
+        }
+        for (e, v) in uj.dext {
+            if e >= ni + lay.nz() {
+                lc.push(jac, row, e, v);
+            } else if e >= ni {
+                jac.push(row, nz + e - ni, v);
+            }
+        }
+    }
+}
+
+/// ∂/∂(q, u) of q̇ = H(q) u (Eq. 13b) and of the gyroscopic terms of Q, body by body.
+fn kinematic_rows(at: &At, jac: &mut Triplets) {
+    let nu = at.lay.u();
+    for (b, body) in at.sys.bodies.iter().enumerate() {
+        let o = NQ * b;
+        let (qb, ub) = (&at.q[o..o + NQ], &at.u[o..o + NQ]);
+        let dq = dqdot_dq(qb, ub);
+        for r in 3..6 {
+            for c in 3..6 {
+                jac.push(o + r, o + c, dq[r * 6 + c]);
+            }
+        }
+        // ∂q̇/∂u = H: identity for v, the Euler block for ω'.
+        for c in 0..3 {
+            jac.push(o + c, nu + o + c, 1.0);
+        }
+        let h = h_angular(qb[4], qb[5]);
+        for r in 0..3 {
+            for c in 0..3 {
+                jac.push(o + 3 + r, nu + o + 3 + c, h.0[r][c]);
+            }
+        }
+        let (_, gj) = gyroscopic(&body.inertia, &ub[3..6]);
+        for r in 0..3 {
+            for c in 0..3 {
+                jac.push(nu + o + 3 + r, nu + o + 3 + c, gj[r * 3 + c]);
+            }
+        }
+    }
+}
+
+/// ∂/∂y of g = B u + b (ν rows) and of −Bᵀν in the force balance.
+fn nonholonomic_rows(at: &At, jac: &mut Triplets) {
+    let (nu, nn) = (at.lay.u(), at.lay.nu());
+    for el in &at.sys.nonholonomic {
+        let s = nonholonomic_second(at.sys, el, at.q, at.u, at.t, at.ext);
+        let (nql, k) = (NQ * el.bodies.len(), s.k);
+        let mut bq = vec![0.0; 2 * nql * nql]; // Σ ν_e ∂B_e/∂(q, u), rows = u entries
+        for e in 0..el.neq {
+            let row = nn + el.row + e;
+            let g = &s.grad[e * k..(e + 1) * k];
+            let hs = &s.hess[e * k * k..(e + 1) * k * k];
+            let nu_e = at.y[row];
+            for a in 0..nql {
+                let ga = global_column(&el.bodies, a);
+                jac.push(row, ga, g[a]);
+                jac.push(row, nu + ga, g[nql + a]);
+                jac.push(nu + ga, row, -g[nql + a]);
+                if nu_e != 0.0 {
+                    for c in 0..2 * nql {
+                        bq[a * 2 * nql + c] += nu_e * hs[(nql + a) * k + c];
+                    }
+                }
+            }
+        }
+        for a in 0..nql {
+            let ga = global_column(&el.bodies, a);
+            for c in 0..2 * nql {
+                let gc = global_column(&el.bodies, c % nql) + if c < nql { 0 } else { nu };
+                jac.push(nu + ga, gc, -bq[a * 2 * nql + c]);
+            }
+        }
+    }
+}
+
+/// ∂Q/∂y of the force elements (over q, u, and the external values they read).
+fn force_rows(at: &At, lc: &LoadChain, jac: &mut Triplets) {
+    let (sys, lay) = (at.sys, at.lay);
+    let (nz, nu, ni) = (lay.z(), lay.u(), sys.ni());
+    for el in &sys.forces {
+        let nql = NQ * el.bodies.len();
+        let (_, fj) = force_jacobian(sys, el, at.q, at.u, at.t, at.ext);
+        for r in 0..nql {
+            let gr = nu + global_column(&el.bodies, r);
+            for a in 0..nql {
+                let ga = global_column(&el.bodies, a);
+                jac.push(gr, ga, fj[r * 2 * nql + a]);
+                jac.push(gr, nu + ga, fj[r * 2 * nql + nql + a]);
+            }
+        }
+        for (e, col) in force_ext_jacobian(sys, el, at.q, at.u, at.t, at.ext) {
+            for (r, v) in col.iter().enumerate() {
+                if e >= ni + lay.nz() {
+                    lc.push(jac, nu + global_column(&el.bodies, r), e, *v);
+                } else if e >= ni {
+                    jac.push(nu + global_column(&el.bodies, r), nz + e - ni, *v);
+                }
+            }
+        }
+    }
+}
+
+/// ∂/∂y of C (λ rows), Ċ (μ rows), −Pᵀλ (force balance) and −C_qᵀμ (q̇ rows); a
+/// redundant row has the identity (λ = μ = 0).
+fn constraint_rows(at: &At, jac: &mut Triplets) {
+    let (sys, q, u) = (at.sys, at.q, at.u);
+    let (nu, nl, nm) = (at.lay.u(), at.lay.lam(), at.lay.mu());
+    for el in &sys.constraints {
+        let s = constraint_second(sys, el, q, at.t, at.ext);
+        let nql = NQ * el.bodies.len();
+        let k = s.k;
+        let ql = gather(&el.bodies, q);
+        let ul = gather(&el.bodies, u);
+        let mut qd = vec![0.0; nql];
+        let mut dq = Vec::with_capacity(el.bodies.len());
+        for kb in 0..el.bodies.len() {
+            let r = NQ * kb..NQ * kb + NQ;
+            qd[r.clone()].copy_from_slice(&qdot(&ql[r.clone()], &ul[r.clone()]));
+            dq.push(dqdot_dq(&ql[r.clone()], &ul[r]));
+        }
+        let mut lq = vec![0.0; nql * nql];
+        for e in 0..el.neq {
+            let row = el.row + e;
+            if sys.redundant[row] {
+                jac.push(nl + row, nl + row, 1.0);
+                jac.push(nm + row, nm + row, 1.0);
+                continue;
+            }
+            let lam = at.y[nl + row];
+            let g = &s.grad[e * k..(e + 1) * k];
+            let hs = &s.hess[e * k * k..(e + 1) * k * k];
+            let p = p_row(&el.bodies, q, &g[..nql]);
+            for a in 0..nql {
+                let ga = global_column(&el.bodies, a);
+                // C_q (Eq. 13e rows), −C_qᵀ (q̇ rows, μ column), −Pᵀ (u rows, λ column), P (Ċ rows).
+                jac.push(nl + row, ga, g[a]);
+                jac.push(ga, nm + row, -g[a]);
+                jac.push(nu + ga, nl + row, -p[a]);
+                jac.push(nm + row, nu + ga, p[a]);
+                // Ċ_q = Σ_c C_qc,qa q̇_c + C_q ∂q̇/∂q_a + C_t,qa.
+                let kb = a / NQ;
+                let mut v = hs[a * k + nql];
+                for c in 0..nql {
+                    v += hs[c * k + a] * qd[c];
+                }
+                for c in 0..NQ {
+                    v += g[NQ * kb + c] * dq[kb][c * 6 + a % NQ];
+                }
+                jac.push(nm + row, ga, v);
+            }
+            if lam != 0.0 {
+                // (Pᵀλ)_q = λ [Hᵀ ∂C_q/∂q + ∂(Hᵀ w)/∂q |_{w = C_q}].
+                for a in 0..nql {
+                    let col: Vec<f64> = (0..nql).map(|c| hs[c * k + a]).collect();
+                    let ht = p_row(&el.bodies, q, &col);
+                    for r in 0..nql {
+                        lq[r * nql + a] += lam * ht[r];
+                    }
+                }
+                for (kb, &b) in el.bodies.iter().enumerate() {
+                    let d = dhtw_dq(&q[NQ * b..NQ * b + NQ], &g[NQ * kb..NQ * kb + NQ]);
+                    for r in 0..NQ {
+                        for c in 0..NQ {
+                            lq[(NQ * kb + r) * nql + NQ * kb + c] += lam * d[r * 6 + c];
+                        }
+                    }
+                }
+            }
+        }
+        for r in 0..nql {
+            for a in 0..nql {
+                jac.push(nu + global_column(&el.bodies, r), global_column(&el.bodies, a), -lq[r * nql + a]);
+            }
+        }
+    }
+}
+
+/// Bodies with acceleration unknowns: their u-row entries belong to the algebraic rows
+/// M a − (Q − Pᵀλ − Bᵀν) (moved, then −M), and the u rows become u' = a.
+fn acceleration_rows(at: &At, jac: &mut Triplets) {
+    let (sys, lay) = (at.sys, at.lay);
+    if sys.acc_bodies.is_empty() {
+        return;
+    }
+    let nu = lay.u();
+    let mut row_of = std::collections::HashMap::new();
+    for (k, &b) in sys.acc_bodies.iter().enumerate() {
+        for c in 0..NQ {
+            row_of.insert(nu + NQ * b + c, lay.acc() + NQ * k + c);
+        }
+    }
+    for p in jac.idx.iter_mut() {
+        if let Some(&r) = row_of.get(&p.row) {
+            p.row = r;
+        }
+    }
+    for (k, &b) in sys.acc_bodies.iter().enumerate() {
+        let (o, ra) = (NQ * b, lay.acc() + NQ * k);
+        for (r, c, v) in body_mass_entries(sys, b, at.q) {
+            jac.push(ra + r - o, ra + c - o, -v);
+        }
+        for c in 0..NQ {
+            jac.push(nu + o + c, ra + c, 1.0);
+        }
+    }
+}
+
+/// The chain rule through element loads read as external values (`System::load_refs`):
+/// ∂r/∂L · ∂L/∂(q, u, λ, Z), with each load's exact gradient from [`crate::mechanics::loads`].
+struct LoadChain {
+    lay: Layout,
+    ni: usize,
+    grads: Vec<Option<LoadGradient>>,
+}
+
+impl LoadChain {
+    fn new(sys: &System, lay: Layout, y: &[f64], t: f64, ext: &[f64]) -> LoadChain {
+        let ni = sys.ni();
+        let base = &ext[..ni + lay.nz()];
+        let state = (&y[lay.q_range()], &y[lay.u_range()], &y[lay.lam_range()]);
+        let grads = sys.load_refs.iter().map(|&r| load_gradient(sys, r, state, t, base)).collect();
+        LoadChain { lay, ni, grads }
+    }
+
+    /// Add coeff · ∂L_e/∂(unknowns) to row `row` (e: external-value index of a load).
+    fn push(&self, jac: &mut Triplets, row: usize, e: usize, coeff: f64) {
+        let lay = self.lay;
+        let k = e - self.ni - lay.nz();
+        let Some(g) = &self.grads[k / NLOAD] else { return };
+        g.terms(k % NLOAD, |term, d| match term {
+            LoadTerm::Q(i) => jac.push(row, i, coeff * d),
+            LoadTerm::U(i) => jac.push(row, lay.u() + i, coeff * d),
+            LoadTerm::Lam(r) => jac.push(row, lay.lam() + r, coeff * d),
+            LoadTerm::Ext(x) if x >= self.ni && x < self.ni + lay.nz() => {
+                jac.push(row, lay.z() + x - self.ni, coeff * d)
+            }
+            LoadTerm::Ext(_) => {}
+        });
+    }
+}

@@ -1,0 +1,154 @@
+//! The constraint Jacobian, assembled in this one place for every user: the rows C_q of
+//! the holonomic constraints (seed Eq. 1b), their velocity form P = C_q H (Eq. 13a,
+//! 13d), with C and C_t alongside, the filter that leaves out redundant rows, and the γ
+//! of the acceleration constraints (Eq. 1c).
+//!
+//! Rows are numbered by the elements' `row` fields; every local entry is kept, zeros
+//! included, so the sparsity pattern does not change from one point to the next.
+
+use super::body::{NQ, h_transpose_times, qdot};
+use super::constraints::ConstraintEl;
+use super::kernels::{constraint_first, constraint_second, dqdot_dq, gather};
+use super::system::System;
+
+/// Constraint rows of a set of elements at (q, t).
+#[derive(Clone, Debug, Default)]
+pub struct ConstraintRows {
+    /// C of every row.
+    pub c: Vec<f64>,
+    /// C_t of every row.
+    pub ct: Vec<f64>,
+    /// Entries (row, global column, value), row by row in element order.
+    pub entries: Vec<(usize, usize, f64)>,
+}
+
+/// Global column of local coordinate `a` of an element touching `bodies`.
+#[inline]
+pub fn global_column(bodies: &[usize], a: usize) -> usize {
+    NQ * bodies[a / NQ] + a % NQ
+}
+
+/// P row of one equation (local, 6 per body) from its C_q row: P = C_q H (Eq. 13a).
+pub fn p_row(bodies: &[usize], q: &[f64], cq: &[f64]) -> Vec<f64> {
+    let mut p = vec![0.0; cq.len()];
+    for (k, &b) in bodies.iter().enumerate() {
+        let r = h_transpose_times(&q[NQ * b..NQ * b + NQ], &cq[NQ * k..NQ * k + NQ]);
+        p[NQ * k..NQ * k + NQ].copy_from_slice(&r);
+    }
+    p
+}
+
+/// C_q rows (Eq. 1b) of the elements `els` at (q, t), with C and C_t; `ext` holds the
+/// external values.
+pub fn constraint_rows(sys: &System, els: &[ConstraintEl], q: &[f64], t: f64, ext: &[f64]) -> ConstraintRows {
+    let nrows = els.iter().map(|e| e.row + e.neq).max().unwrap_or(0);
+    let mut out = ConstraintRows { c: vec![0.0; nrows], ct: vec![0.0; nrows], entries: Vec::new() };
+    for el in els {
+        let f = constraint_first(sys, el, q, t, ext);
+        let nql = NQ * el.bodies.len();
+        for e in 0..el.neq {
+            let row = el.row + e;
+            out.c[row] = f.c[e];
+            out.ct[row] = f.ct[e];
+            let cq = &f.cq[e * nql..(e + 1) * nql];
+            out.entries.extend(cq.iter().enumerate().map(|(a, &v)| (row, global_column(&el.bodies, a), v)));
+        }
+    }
+    out
+}
+
+/// The C_q rows of the model's holonomic constraints (`sys.constraints`, m rows).
+pub fn constraint_jacobian(sys: &System, q: &[f64], t: f64, ext: &[f64]) -> ConstraintRows {
+    let mut rows = constraint_rows(sys, &sys.constraints, q, t, ext);
+    rows.c.resize(sys.m, 0.0);
+    rows.ct.resize(sys.m, 0.0);
+    rows
+}
+
+/// The independent constraint rows: those not found redundant at initialization
+/// (`System::redundant`), numbered compactly in their order. Redundant rows keep λ = 0
+/// and leave their equations out (Eq. 34d–e have `count` rows).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct IndependentRows {
+    /// Compact index of each of the m rows (None: redundant).
+    pub of_row: Vec<Option<usize>>,
+    /// Number of independent rows (m minus the redundant ones).
+    pub count: usize,
+}
+
+impl IndependentRows {
+    /// The independent rows of `sys`.
+    pub fn of(sys: &System) -> IndependentRows {
+        let mut count = 0;
+        let of_row = sys
+            .redundant
+            .iter()
+            .map(|&r| {
+                (!r).then(|| {
+                    count += 1;
+                    count - 1
+                })
+            })
+            .collect();
+        IndependentRows { of_row, count }
+    }
+}
+
+impl ConstraintRows {
+    /// The velocity form P = C_q H (Eq. 13a, 13d) of C_q rows at q: the same rows as a
+    /// linear form in the velocities u (C and C_t unchanged).
+    pub fn velocity_form(&self, q: &[f64]) -> ConstraintRows {
+        let mut entries = Vec::with_capacity(self.entries.len());
+        // Every row holds NQ consecutive entries per body it touches (see `constraint_rows`).
+        for chunk in self.entries.chunks_exact(NQ) {
+            let (row, c0) = (chunk[0].0, chunk[0].1);
+            debug_assert!(chunk.iter().enumerate().all(|(k, e)| e.0 == row && e.1 == c0 + k));
+            let cq: Vec<f64> = chunk.iter().map(|e| e.2).collect();
+            let p = h_transpose_times(&q[c0..c0 + NQ], &cq);
+            entries.extend(p.iter().enumerate().map(|(k, &v)| (row, c0 + k, v)));
+        }
+        ConstraintRows { c: self.c.clone(), ct: self.ct.clone(), entries }
+    }
+
+    /// The entries of the independent rows, renumbered compactly (see [`IndependentRows`]).
+    pub fn independent<'a>(&'a self, rows: &'a IndependentRows) -> impl Iterator<Item = (usize, usize, f64)> + 'a {
+        self.entries.iter().filter_map(|&(r, c, v)| rows.of_row.get(r).copied().flatten().map(|k| (k, c, v)))
+    }
+}
+
+/// γ of the acceleration constraint P u̇ + γ = 0 (Eq. 1c): the part of C̈ free of u̇.
+pub fn acceleration_rhs(sys: &System, q: &[f64], u: &[f64], t: f64, inputs: &[f64]) -> Vec<f64> {
+    let mut gamma = vec![0.0; sys.m];
+    for el in &sys.constraints {
+        let s = constraint_second(sys, el, q, t, inputs);
+        let nql = NQ * el.bodies.len();
+        let k = s.k;
+        let ql = gather(&el.bodies, q);
+        let ul = gather(&el.bodies, u);
+        // z' = (q̇, 1): γ = z'ᵀ ∇²C z' + C_q (∂q̇/∂q) q̇.
+        let mut zd = vec![1.0; k];
+        let mut extra = vec![0.0; nql];
+        for kb in 0..el.bodies.len() {
+            let r = NQ * kb..NQ * kb + NQ;
+            let qd = qdot(&ql[r.clone()], &ul[r.clone()]);
+            zd[r.clone()].copy_from_slice(&qd);
+            let dq = dqdot_dq(&ql[r.clone()], &ul[r]);
+            for i in 0..NQ {
+                extra[NQ * kb + i] = (0..NQ).map(|c| dq[i * 6 + c] * qd[c]).sum();
+            }
+        }
+        for e in 0..el.neq {
+            let g = &s.grad[e * k..(e + 1) * k];
+            let hs = &s.hess[e * k * k..(e + 1) * k * k];
+            let mut v = 0.0;
+            for a in 0..k {
+                for c in 0..k {
+                    v += zd[a] * hs[a * k + c] * zd[c];
+                }
+            }
+            v += (0..nql).map(|a| g[a] * extra[a]).sum::<f64>();
+            gamma[el.row + e] = v;
+        }
+    }
+    gamma
+}

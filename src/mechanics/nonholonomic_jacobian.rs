@@ -1,0 +1,46 @@
+//! The velocity-level Jacobian of the non-holonomic constraints g(q, u, t) = B u + b = 0:
+//! B = ∂g/∂u with g, and the γ of their acceleration form B u̇ + γ = 0, assembled in this
+//! one place for every user.
+
+use super::body::{NQ, qdot};
+use super::constraint_jacobian::global_column;
+use super::kernels::{gather, nonholonomic_second};
+use super::system::System;
+
+/// γ of the non-holonomic acceleration constraint B u̇ + γ = 0: ġ at u̇ = 0, i.e.
+/// g_q q̇ + g_t.
+pub fn nonholonomic_gamma(sys: &System, q: &[f64], u: &[f64], t: f64, ext: &[f64]) -> Vec<f64> {
+    let mut gamma = vec![0.0; sys.mn];
+    for el in &sys.nonholonomic {
+        let s = nonholonomic_second(sys, el, q, u, t, ext);
+        let nql = NQ * el.bodies.len();
+        let (ql, ul) = (gather(&el.bodies, q), gather(&el.bodies, u));
+        let mut qd = vec![0.0; nql];
+        for kb in 0..el.bodies.len() {
+            let r = NQ * kb..NQ * kb + NQ;
+            qd[r.clone()].copy_from_slice(&qdot(&ql[r.clone()], &ul[r]));
+        }
+        for e in 0..el.neq {
+            let g = &s.grad[e * s.k..(e + 1) * s.k];
+            gamma[el.row + e] = (0..nql).map(|a| g[a] * qd[a]).sum::<f64>() + g[2 * nql];
+        }
+    }
+    gamma
+}
+
+/// B = ∂g/∂u of the non-holonomic constraints as (row, global column, value), with g.
+pub fn nonholonomic_b(sys: &System, q: &[f64], u: &[f64], t: f64, ext: &[f64]) -> (Vec<(usize, usize, f64)>, Vec<f64>) {
+    let mut b = Vec::new();
+    let mut g = vec![0.0; sys.mn];
+    for el in &sys.nonholonomic {
+        let s = nonholonomic_second(sys, el, q, u, t, ext);
+        let nql = NQ * el.bodies.len();
+        for e in 0..el.neq {
+            g[el.row + e] = s.c[e];
+            for a in 0..nql {
+                b.push((el.row + e, global_column(&el.bodies, a), s.grad[e * s.k + nql + a]));
+            }
+        }
+    }
+    (b, g)
+}
