@@ -13,7 +13,7 @@ use std::ffi::CString;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
-use crate::common::host::{CALLBACKS, resources};
+use crate::common::host::{self, CALLBACKS, resources};
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -155,14 +155,14 @@ fn a_model_whose_states_cannot_be_selected_packs_with_a_located_warning_and_fail
     let g = CString::new(guid(&bad)).expect("no NUL");
     // SAFETY: valid NUL-terminated strings and callbacks; a live instance, freed once.
     unsafe {
-        let c = fmi2Instantiate(c"bad".as_ptr(), CO_SIMULATION, g.as_ptr(), uri.as_ptr(), &CALLBACKS, 0, 0);
+        let c = host::instantiate(c"bad".as_ptr(), CO_SIMULATION, g.as_ptr(), uri.as_ptr(), 0, 0);
         assert!(!c.is_null());
         assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), mbfmu::fmi::types::Status::Ok);
         assert_eq!(fmi2EnterInitializationMode(c), mbfmu::fmi::types::Status::Ok);
         assert_eq!(fmi2ExitInitializationMode(c), mbfmu::fmi::types::Status::Error);
-        let msgs = last_messages(c).join("\n");
+        let msgs = host::messages(c).join("\n");
         assert!(msgs.contains("model.xml:") && msgs.contains("joint 'rocker_pin'"), "{msgs}");
-        fmi2FreeInstance(c);
+        host::free(c);
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
