@@ -14,9 +14,9 @@ pub use super::jacobian::jacobian;
 pub use super::layout::Layout;
 pub use super::residual::{applied_forces, rhs};
 use super::sparse::Triplets;
-pub use crate::mechanics::constraint_jacobian::{acceleration_rhs, p_row};
 use crate::mechanics::System;
 use crate::mechanics::body::NQ;
+pub use crate::mechanics::constraint_jacobian::{acceleration_rhs, p_row};
 use crate::mechanics::mass::{body_mass_entries, constant_mass};
 pub use crate::mechanics::nonholonomic_jacobian::{nonholonomic_b, nonholonomic_gamma};
 
