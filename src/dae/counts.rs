@@ -4,12 +4,11 @@
 //! of the velocity form P u of the holonomic ones. Degrees of freedom are n − rank C_q
 //! (positions) and that minus the independent non-holonomic rows (velocities).
 
-use super::equations::{nonholonomic_b, p_row};
 use super::init::REDUNDANCY_TOL;
 use super::rank::full_pivot;
 use crate::mechanics::System;
-use crate::mechanics::body::NQ;
-use crate::mechanics::kernels::constraint_first;
+use crate::mechanics::constraint_jacobian::{IndependentRows, constraint_jacobian};
+use crate::mechanics::nonholonomic_jacobian::nonholonomic_b;
 
 /// The counts, with the redundant rows named by element.
 #[derive(Clone, Debug, PartialEq)]
@@ -44,24 +43,18 @@ impl Counts {
 /// (Simulator::new), `inputs` the input values and `ext` the external vector.
 pub fn counts(sys: &System, q: &[f64], u: &[f64], t: f64, inputs: &[f64], ext: &[f64]) -> Counts {
     let n = sys.n();
-    let mut redundant = Vec::new();
-    let mut pt = Vec::new(); // Pᵀ of the independent rows: (coordinate, column, value)
-    let mut cols = 0;
-    for el in &sys.constraints {
-        let k = (0..el.neq).filter(|&e| sys.redundant[el.row + e]).count();
-        if k > 0 {
-            redundant.push((format!("{} '{}'", el.tag, el.name), k));
-        }
-        let f = constraint_first(sys, el, q, t, inputs);
-        let nql = NQ * el.bodies.len();
-        for e in (0..el.neq).filter(|&e| !sys.redundant[el.row + e]) {
-            for (a, v) in p_row(&el.bodies, q, &f.cq[e * nql..(e + 1) * nql]).into_iter().enumerate() {
-                pt.push((NQ * el.bodies[a / NQ] + a % NQ, cols, v));
-            }
-            cols += 1;
-        }
-    }
-    let independent = cols;
+    let redundant = sys
+        .constraints
+        .iter()
+        .map(|el| (el, (0..el.neq).filter(|&e| sys.redundant[el.row + e]).count()))
+        .filter(|&(_, k)| k > 0)
+        .map(|(el, k)| (format!("{} '{}'", el.tag, el.name), k))
+        .collect();
+    // Pᵀ of the independent rows, then Bᵀ: (coordinate, column, value).
+    let rows = IndependentRows::of(sys);
+    let p = constraint_jacobian(sys, q, t, inputs).velocity_form(q);
+    let mut pt: Vec<(usize, usize, f64)> = p.independent(&rows).map(|(r, c, v)| (c, r, v)).collect();
+    let independent = rows.count;
     let mut nh_independent = 0;
     if sys.mn > 0 {
         let (b, _) = nonholonomic_b(sys, q, u, t, ext);

@@ -12,13 +12,11 @@
 
 pub use super::jacobian::jacobian;
 pub use super::layout::Layout;
-pub use super::residual::{applied_forces, rhs};
+pub use super::residual::rhs;
 use super::sparse::Triplets;
 use crate::mechanics::System;
 use crate::mechanics::body::NQ;
-pub use crate::mechanics::constraint_jacobian::{acceleration_rhs, p_row};
 use crate::mechanics::mass::{body_mass_entries, constant_mass};
-pub use crate::mechanics::nonholonomic_jacobian::{nonholonomic_b, nonholonomic_gamma};
 
 /// The integrator's mass matrix diag(I, M, [I 0 0], 0, 0) of M y' = f; constant: it
 /// holds the blocks of bodies whose mass does not depend on q (every rigid body), and

@@ -1,13 +1,14 @@
 //! Reading a simulation: outputs and their time derivatives, body states, energy,
 //! constraint residuals, state names and values.
 
-use super::equations;
 use super::error::EngineError;
 use super::simulator::Simulator;
-use crate::geom::{M3, V3};
+use crate::geom::V3;
 use crate::mechanics::body::{NQ, body_frame};
 use crate::mechanics::loads::{load_index, load_value};
 use crate::mechanics::local::LocalCtx;
+use crate::mechanics::mass::body_kinetic_energy;
+use crate::mechanics::nonholonomic_jacobian::nonholonomic_b;
 use crate::model::expr::{ElementRef, LoadFn};
 
 /// Kinematic state of one body, ground components.
@@ -53,7 +54,7 @@ impl Simulator {
     pub fn nonholonomic_residual(&self) -> f64 {
         let s = &self.dae.sys;
         let ext = self.ext();
-        let (_, g) = equations::nonholonomic_b(s, self.q(), self.u(), self.radau.t, &ext);
+        let (_, g) = nonholonomic_b(s, self.q(), self.u(), self.radau.t, &ext);
         g.iter().fold(0.0, |a: f64, v| a.max(v.abs()))
     }
 
@@ -89,12 +90,8 @@ impl Simulator {
         let (q, u) = (self.q(), self.u());
         let mut e = 0.0;
         for (b, body) in s.bodies.iter().enumerate() {
-            let o = NQ * b;
-            let v = &u[o..o + 3];
-            let w = V3([u[o + 3], u[o + 4], u[o + 5]]);
-            let jw = M3::cst(&body.inertia).mv(&w);
-            e += 0.5 * body.mass * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) + 0.5 * w.dot(&jw);
-            e -= body.mass * (0..3).map(|c| s.gravity[c] * q[o + c]).sum::<f64>();
+            e += body_kinetic_energy(s, b, q, u);
+            e -= body.mass * (0..3).map(|c| s.gravity[c] * q[NQ * b + c]).sum::<f64>();
         }
         for el in &s.forces {
             let ql = crate::mechanics::kernels::gather(&el.bodies, q);

@@ -60,13 +60,13 @@ impl DaeProblem for MultibodyDae {
                 changed = true;
             }
         }
-        let n = self.lay.n;
+        let (qs, us) = (self.lay.q_range(), self.lay.u_range());
         let ext = self.lay.ext(&self.sys, &self.inputs_at(t), y, t);
-        self.record_angles(t, &y[..n], &y[n..2 * n], &ext);
+        self.record_angles(t, &y[qs.clone()], &y[us], &ext);
         let inputs = ext;
         for k in 0..self.sys.forces.len() {
             let el = &self.sys.forces[k];
-            let ql = crate::mechanics::kernels::gather(&el.bodies, &y[..n]);
+            let ql = crate::mechanics::kernels::gather(&el.bodies, &y[qs.clone()]);
             let ctx = LocalCtx::new(&self.sys, &el.bodies, &ql, &[], &[], t, &inputs);
             if let Some(a) = el.angle(&ctx) {
                 self.sys.forces[k].angle_ref = a;

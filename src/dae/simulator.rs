@@ -59,11 +59,7 @@ impl Simulator {
         let mut acc_lu = SparseLu::new();
         let (udot, lam) = init::consistent_accelerations(&sys, &q, &u, t0, &inputs, &mut z, &mut acc_lu)
             .map_err(EngineError::Numeric)?;
-        let mut y = vec![0.0; lay.dim()];
-        y[..lay.n].copy_from_slice(&q);
-        y[lay.u()..lay.u() + lay.n].copy_from_slice(&u);
-        y[lay.z()..lay.z() + lay.nz()].copy_from_slice(&z);
-        y[lay.lam()..lay.lam() + lay.m + lay.mn].copy_from_slice(&lam); // λ then ν
+        let mut y = lay.assemble(&q, &u, &z, &lam);
         let slopes = vec![0.0; inputs.len()];
         let mut dae = MultibodyDae { sys, lay, inputs, slopes, t_in: t0 };
         dae.accepted(t0, &mut y);
@@ -118,13 +114,12 @@ impl Simulator {
 
     /// Current coordinates q.
     pub fn q(&self) -> &[f64] {
-        &self.radau.y[..self.dae.lay.n]
+        &self.radau.y[self.dae.lay.q_range()]
     }
 
     /// Current velocities u.
     pub fn u(&self) -> &[f64] {
-        let l = self.dae.lay;
-        &self.radau.y[l.u()..l.u() + l.n]
+        &self.radau.y[self.dae.lay.u_range()]
     }
 
     /// Accelerations u̇ and multipliers λ at the current time (Eq. 1c–1d).
@@ -155,15 +150,15 @@ impl Simulator {
     /// The external values with the element loads evaluated at multipliers `lam` (those of
     /// [`Simulator::accelerations`], so outputs and linearization see one consistent λ).
     pub fn ext_with(&self, lam: &[f64]) -> Vec<f64> {
-        let (n, m, t) = (self.dae.lay.n, self.dae.sys.m, self.radau.t);
+        let (lay, t) = (self.dae.lay, self.radau.t);
         let y = &self.radau.y;
-        let state = (&y[..n], &y[n..2 * n], &lam[..m]);
+        let state = (&y[lay.q_range()], &y[lay.u_range()], &lam[..lay.m]);
         let mut z = self.user_values().to_vec();
         // Acceleration unknowns: those of the same solve as λ.
         if let Some((udot, _)) = &self.acc {
-            let a0 = self.dae.lay.acc() - self.dae.lay.z();
+            let a0 = lay.acc() - lay.z();
             for (k, &b) in self.dae.sys.acc_bodies.iter().enumerate() {
-                z[a0 + NQ * k..a0 + NQ * k + NQ].copy_from_slice(&udot[NQ * b..NQ * b + NQ]);
+                z[a0 + NQ * k..a0 + NQ * (k + 1)].copy_from_slice(&udot[NQ * b..NQ * (b + 1)]);
             }
         }
         self.dae.sys.ext(&self.dae.inputs_at(t), &z, Some(state), t)
@@ -172,7 +167,7 @@ impl Simulator {
     /// Current user unknowns Z = (X, Ẋ, V).
     pub fn user_values(&self) -> &[f64] {
         let l = &self.dae.lay;
-        &self.radau.y[l.z()..l.z() + l.nz()]
+        &self.radau.y[l.z_range()]
     }
 
     /// Number of inputs.
@@ -213,15 +208,15 @@ impl Simulator {
         if l.nz() == l.nx {
             return Ok(());
         }
-        let (z0, nz, lam0) = (l.z(), l.nz(), l.lam());
+        let (zs, lam0) = (l.z_range(), l.lam());
         let (q, u) = (self.q().to_vec(), self.u().to_vec());
         let t = self.radau.t;
         let mut z = self.user_values().to_vec();
         let inputs = self.dae.inputs_at(t);
         let (udot, lam) = init::consistent_accelerations(&self.dae.sys, &q, &u, t, &inputs, &mut z, &mut self.acc_lu)
             .map_err(EngineError::Numeric)?;
-        self.radau.y[z0..z0 + nz].copy_from_slice(&z);
-        self.radau.y[lam0..lam0 + lam.len()].copy_from_slice(&lam);
+        self.radau.y[zs].copy_from_slice(&z);
+        self.radau.y[lam0..lam0 + lam.len()].copy_from_slice(&lam); // λ then ν
         self.acc = Some((udot, lam));
         Ok(())
     }

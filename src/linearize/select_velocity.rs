@@ -11,9 +11,9 @@ use super::jets::jets;
 use super::states::{StateFn, VelState, internal_state, user_velocities};
 use super::tiers::{CandidateRow, TierError, choose_in_tiers, constraint_rows, gradient_row};
 use super::tolerances::RANK_TOL;
-use crate::dae::equations::nonholonomic_b;
 use crate::mechanics::System;
 use crate::mechanics::body::{NQ, row_times_t};
+use crate::mechanics::nonholonomic_jacobian::nonholonomic_b;
 
 /// Sparse entries of a dense row.
 fn sparse(row: &[f64]) -> Vec<(usize, f64)> {

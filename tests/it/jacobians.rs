@@ -4,10 +4,11 @@
 //! general orientations; it need not be assemblable, since derivatives are checked at
 //! arbitrary states.
 
-use mbfmu::dae::equations::{Layout, acceleration_rhs, jacobian, p_row, rhs};
+use mbfmu::dae::equations::{Layout, jacobian, rhs};
 use mbfmu::dae::sparse::Triplets;
 use mbfmu::mechanics::System;
 use mbfmu::mechanics::body::{NQ, qdot};
+use mbfmu::mechanics::constraint_jacobian::{acceleration_rhs, p_row};
 use mbfmu::mechanics::kernels::constraint_first;
 use mbfmu::model::parse::load_str;
 
@@ -180,7 +181,7 @@ fn acceleration_right_hand_side_is_the_second_time_derivative_of_the_constraints
 fn nonholonomic_acceleration_right_hand_side_is_the_time_derivative_of_g() {
     // ġ = B u̇ + γ_nh along q' = H(q)u, u' = a, t' = 1: central differences of g over ±h
     // against B a + γ_nh (h = 1e-5, tolerance as above).
-    use mbfmu::dae::equations::{nonholonomic_b, nonholonomic_gamma};
+    use mbfmu::mechanics::nonholonomic_jacobian::{nonholonomic_b, nonholonomic_gamma};
     let (sys, lay, y) = setup();
     assert_eq!(sys.mn, 6);
     let t = 0.43;
