@@ -31,7 +31,7 @@ unsafe fn store(handles: &mut StateHandles, out: *mut FmuStatePtr, s: FmuState) 
 pub unsafe extern "C" fn fmi2GetFMUstate(c: Component, FMUstate: *mut FmuStatePtr) -> Status {
     guarded(c, Func::GetFmuState, |inst| {
         // SAFETY: per the module's contract.
-        let s = FmuState::capture(inst);
+        let s = inst.save_state();
         // SAFETY: per the module's contract.
         unsafe { store(&mut inst.states, FMUstate, s) }?;
         Ok(Status::Ok)
@@ -44,7 +44,7 @@ pub unsafe extern "C" fn fmi2GetFMUstate(c: Component, FMUstate: *mut FmuStatePt
 pub unsafe extern "C" fn fmi2SetFMUstate(c: Component, FMUstate: FmuStatePtr) -> Status {
     guarded(c, Func::SetFmuState, |inst| {
         let s = inst.states.get(FMUstate)?.clone();
-        s.restore(inst)?;
+        inst.restore_state(&s)?;
         Ok(Status::Ok)
     })
 }

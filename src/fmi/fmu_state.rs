@@ -1,8 +1,8 @@
 //! Saved FMU states (2.1.8 Getting and Setting the Complete FMU State): the instance's
 //! state-machine state, the host's values and the engine state, and their byte form.
 
+use super::config::Config;
 use super::guid::checksum;
-use super::instance::{Config, Instance};
 use super::state_machine::State;
 use crate::dae::SimState;
 use crate::dae::bytes::{ByteReader, ByteWriter};
@@ -22,50 +22,6 @@ pub struct FmuState {
 }
 
 impl FmuState {
-    /// fmi2GetFMUstate. A state taken after fmi2DoStep returned fmi2Discard (StepFailed)
-    /// holds the engine at fmi2LastSuccessfulTime, the last accepted integrator step, which
-    /// is a valid communication point: it is recorded as StepComplete, so that restoring
-    /// it lets the host continue from the time reached (e.g. with a larger
-    /// `solver.maxSteps` or a shorter step).
-    pub fn capture(inst: &Instance) -> FmuState {
-        FmuState {
-            guid: inst.guid.clone(),
-            state: if inst.state == State::StepFailed { State::StepComplete } else { inst.state },
-            config: inst.config.clone(),
-            last_time: inst.last_time,
-            sim: if inst.dirty { None } else { inst.built.as_ref().map(|b| b.sim.snapshot()) },
-        }
-    }
-
-    /// fmi2SetFMUstate: into `inst`, which may be another instance of the same model.
-    pub fn restore(&self, inst: &mut Instance) -> Result<(), String> {
-        if self.guid != inst.guid {
-            return Err(format!("the state belongs to FMU {}, not to this FMU {}", self.guid, inst.guid));
-        }
-        match &self.sim {
-            None => {
-                inst.built = None;
-                inst.dirty = true;
-            }
-            Some(s) => {
-                let reusable = inst.built.as_ref().is_some_and(|b| {
-                    !inst.dirty && b.tol.to_bits() == self.config.tol.to_bits() && same(&b.params, &self.config.params)
-                });
-                if !reusable {
-                    inst.built = Some(inst.build(&self.config)?);
-                }
-                let sim = &mut inst.built.as_mut().expect("built").sim;
-                sim.restore(s).map_err(|e| e.to_string())?;
-                sim.set_max_steps(self.config.max_steps);
-                inst.dirty = false;
-            }
-        }
-        inst.config = self.config.clone();
-        inst.last_time = self.last_time;
-        inst.state = self.state;
-        Ok(())
-    }
-
     /// fmi2SerializeFMUstate: the magic `MBFMUF02`, GUID, state, configuration (with
     /// `solver.maxSteps`), engine state, and a checksum of all before it.
     pub fn to_bytes(&self) -> Vec<u8> {
@@ -121,10 +77,6 @@ impl FmuState {
         let config = Config { params, inputs, slopes, tol: head[0], start: head[1], stop, max_steps };
         Ok(FmuState { guid, state, config, last_time: head[3], sim })
     }
-}
-
-fn same(a: &[f64], b: &[f64]) -> bool {
-    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
 }
 
 #[cfg(test)]

@@ -2,6 +2,8 @@
 //! once initialized. It knows the FMI rules for values (who may set what, when); the
 //! exports only translate pointers and statuses.
 
+use super::config::Config;
+use super::fmu_state::FmuState;
 use super::logger::Logger;
 use super::state_handles::StateHandles;
 use super::state_machine::State;
@@ -10,26 +12,6 @@ use super::variables::{Target, Variable, variables};
 use crate::dae::{DEFAULT_MAX_STEPS, SimOptions, SimState, Simulator};
 use crate::linearize::{Linearization, Selection, StateLayout, linearize, selection_by_name, state_values};
 use crate::model::Model;
-
-/// What the host chose: parameter and input values, input slopes, experiment, solver
-/// settings.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Config {
-    /// Parameter values (model order).
-    pub params: Vec<f64>,
-    /// Input values (model order).
-    pub inputs: Vec<f64>,
-    /// Input slopes (fmi2SetRealInputDerivatives).
-    pub slopes: Vec<f64>,
-    /// Integration tolerance.
-    pub tol: f64,
-    /// Start time.
-    pub start: f64,
-    /// Stop time, if the host gave one.
-    pub stop: Option<f64>,
-    /// `solver.maxSteps`: most integrator step attempts per fmi2DoStep (at least 1).
-    pub max_steps: usize,
-}
 
 /// The engine, with the configuration it was built from.
 pub struct Built {
@@ -544,4 +526,59 @@ impl Instance {
 
 fn bits(v: &[f64]) -> Vec<u64> {
     v.iter().map(|x| x.to_bits()).collect()
+}
+
+/// Saved FMU states (2.1.8).
+impl Instance {
+    /// fmi2GetFMUstate: the complete state. A state taken after fmi2DoStep returned fmi2Discard (StepFailed)
+    /// holds the engine at fmi2LastSuccessfulTime, the last accepted integrator step, which
+    /// is a valid communication point: it is recorded as StepComplete, so that restoring
+    /// it lets the host continue from the time reached (e.g. with a larger
+    /// `solver.maxSteps` or a shorter step).
+    pub fn save_state(&self) -> FmuState {
+        FmuState {
+            guid: self.guid.clone(),
+            state: if self.state == State::StepFailed { State::StepComplete } else { self.state },
+            config: self.config.clone(),
+            last_time: self.last_time,
+            sim: if self.dirty { None } else { self.built.as_ref().map(|b| b.sim.snapshot()) },
+        }
+    }
+
+    /// fmi2SetFMUstate: `saved` into this instance (it may have been saved by another
+    /// instance of the same model).
+    pub fn restore_state(&mut self, saved: &FmuState) -> Result<(), String> {
+        if saved.guid != self.guid {
+            return Err(format!("the state belongs to FMU {}, not to this FMU {}", saved.guid, self.guid));
+        }
+        match &saved.sim {
+            None => {
+                self.built = None;
+                self.dirty = true;
+            }
+            Some(s) => {
+                let reusable = self.built.as_ref().is_some_and(|b| {
+                    !self.dirty
+                        && b.tol.to_bits() == saved.config.tol.to_bits()
+                        && same(&b.params, &saved.config.params)
+                });
+                if !reusable {
+                    self.built = Some(self.build(&saved.config)?);
+                }
+                let sim = &mut self.built.as_mut().expect("built").sim;
+                sim.restore(s).map_err(|e| e.to_string())?;
+                sim.set_max_steps(saved.config.max_steps);
+                self.dirty = false;
+            }
+        }
+        self.config = saved.config.clone();
+        self.last_time = saved.last_time;
+        self.state = saved.state;
+        Ok(())
+    }
+}
+
+/// Bitwise equality of two value lists.
+fn same(a: &[f64], b: &[f64]) -> bool {
+    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
 }

@@ -3,6 +3,7 @@
 //! nothing itself.
 
 pub mod bundle;
+pub mod config;
 pub mod exports_common;
 pub mod exports_cs;
 pub mod exports_me;
