@@ -338,7 +338,7 @@ case!(
 case!(
     m57_state_name_clash,
     "57_state_name_clash.xml",
-    "57_state_name_clash.xml:5:12: state 'height': name 'height' is already an FMI variable (line 3)"
+    "57_state_name_clash.xml:5:12: state 'height': name 'height' is already used by output at line 3"
 );
 
 case!(

@@ -11,6 +11,18 @@ pub enum NameRef {
     Diff(usize),
 }
 
+impl NameRef {
+    /// The element kind the name belongs to, as a model file spells it.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            NameRef::Param(_) => "parameter",
+            NameRef::Input(_) => "input",
+            NameRef::Variable(_) => "variable",
+            NameRef::Diff(_) => "differential",
+        }
+    }
+}
+
 /// Resolves names while parsing; implemented by the model parser.
 pub trait Scope {
     /// A bare identifier (parameter, input, variable, differential).

@@ -329,15 +329,15 @@ impl<'a> Loader<'a> {
             let el = self.el(c);
             let function = el.expr_req("function")?;
             let (name, pos) = (c.label().to_string(), c.pos);
-            // Linearization states become FMI variables: their names must not clash with
-            // the other FMI variables (parameters, inputs, outputs, differentials, variables).
+            // A linearization state is a named quantity of the model, like parameters,
+            // inputs, outputs, differentials and variables: its name is theirs to share.
             let clash = match self.scope.names.get(&name) {
-                Some(&(_, line)) => Some(line),
-                None => self.ns_outputs.line(&name),
+                Some(&(r, line)) => Some((r.kind(), line)),
+                None => self.ns_outputs.line(&name).map(|line| ("output", line)),
             };
-            if let Some(line) = clash {
+            if let Some((kind, line)) = clash {
                 let at = el.get("name").map_or(c.pos, |a| a.pos);
-                return Err(el.err_at(at, format!("name '{name}' is already an FMI variable (line {line})")));
+                return Err(el.err_at(at, format!("name '{name}' is already used by {kind} at line {line}")));
             }
             if c.tag == "state" {
                 check_deps(&el, "function", &function, Allowed::Positions)?;

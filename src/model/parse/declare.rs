@@ -135,12 +135,7 @@ impl<'a> Loader<'a> {
         let mut tmp = Namespace::default();
         let name = self.declare(&mut tmp, x, kind, 0, false)?;
         if let Some(&(prev, line)) = self.scope.names.get(&name) {
-            let prev_kind = match prev {
-                NameRef::Param(_) => "parameter",
-                NameRef::Input(_) => "input",
-                NameRef::Variable(_) => "variable",
-                NameRef::Diff(_) => "differential",
-            };
+            let prev_kind = prev.kind();
             let el = self.el(x);
             let at = el.get("name").map_or(x.pos, |a| a.pos);
             let msg = if prev_kind == kind {
