@@ -5,7 +5,7 @@
 //! (bench/lin_chain.sh runs it on the N-link chains of bench/chain.sh.)
 
 use mbfmu::dae::{SimOptions, Simulator};
-use mbfmu::linearize::augmented::check_partition;
+use mbfmu::linearize::partition::check_partition;
 use mbfmu::linearize::{linearize, select_states};
 use mbfmu::model::parse::load_file;
 use std::time::Instant;

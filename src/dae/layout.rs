@@ -149,6 +149,15 @@ impl Layout {
             Slot::Mu(i - self.mu())
         }
     }
+    /// The row of f that holds the force balance of coordinate `g`: its u row, or for
+    /// a body with acceleration unknowns (`acc_bodies`) its algebraic row
+    /// M a = Q − Pᵀλ − Bᵀν among the user rows.
+    pub fn force_row(&self, acc_bodies: &[usize], g: usize) -> usize {
+        match acc_bodies.iter().position(|&b| b == g / NQ) {
+            Some(k) => self.acc() + NQ * k + g % NQ,
+            None => self.u() + g,
+        }
+    }
     /// A state vector y from its parts (μ = 0); `multipliers` holds λ then ν.
     pub fn assemble(&self, q: &[f64], u: &[f64], z: &[f64], multipliers: &[f64]) -> Vec<f64> {
         let mut y = vec![0.0; self.dim()];

@@ -137,6 +137,25 @@ impl Eq34 {
         EQUATIONS.iter().take_while(|&&x| x != e).map(|&x| self.rows_of(x)).sum()
     }
 
+    /// Column of unknown `i` of block `u`.
+    #[inline]
+    pub fn at(&self, u: Unknown, i: usize) -> usize {
+        debug_assert!(i < self.size_of(u), "{u:?}[{i}] of {}", self.size_of(u));
+        self.col(u) + i
+    }
+
+    /// Row of equation `i` of block `e`.
+    #[inline]
+    pub fn row_at(&self, e: Equation, i: usize) -> usize {
+        debug_assert!(i < self.rows_of(e), "{e:?}[{i}] of {}", self.rows_of(e));
+        self.row(e) + i
+    }
+
+    /// Number of states (S, W, X): the columns of A.
+    pub fn ns(&self) -> usize {
+        self.s0 + self.s1 + self.nx
+    }
+
     /// Dimension of the (square) system.
     pub fn dim(&self) -> usize {
         let cols: usize = UNKNOWNS.iter().map(|&u| self.size_of(u)).sum();

@@ -2,15 +2,20 @@
 //! the augmented sensitivity system (Eq. 34, Table 1) solved with one sparse LU for all
 //! right-hand sides, and the eigenvalue table (Tables 2–4).
 
+pub mod assemble;
 pub mod augmented;
 pub mod candidates;
 pub mod eigen;
 pub mod eq34;
+pub mod extract;
 pub mod jets;
 pub mod layout;
 pub mod outputs;
+pub mod partition;
+pub mod rhs;
 pub mod select;
 pub mod select_velocity;
+pub mod sensitivity;
 pub mod states;
 pub mod structure;
 pub mod tiers;
