@@ -61,6 +61,9 @@ pub struct SparseLu {
     pub analyses: usize,
 }
 
+/// faer's LU variant: supernodal (the default: 2× faster than simplicial on the chains
+/// of `bench/`), or simplicial when the environment variable `MBFMU_LU=simplicial` is set,
+/// to compare the two in benchmarks (README, Benchmark). Results agree to round-off.
 fn supernodal_threshold() -> SupernodalThreshold {
     match std::env::var("MBFMU_LU").as_deref() {
         Ok("simplicial") => SupernodalThreshold::FORCE_SIMPLICIAL,

@@ -12,12 +12,24 @@ use super::states::{StateFn, VelState, internal_state, user_velocities};
 use super::tiers::{CandidateRow, TierError, choose_in_tiers, constraint_rows, gradient_row};
 use super::tolerances::RANK_TOL;
 use crate::mechanics::System;
-use crate::mechanics::body::{NQ, row_times_t};
+use crate::mechanics::body::{NQ, block_times_t};
+use crate::mechanics::constraint_jacobian::global_column;
 use crate::mechanics::nonholonomic_jacobian::nonholonomic_b;
+use std::collections::BTreeMap;
 
 /// Sparse entries of a dense row.
-fn sparse(row: &[f64]) -> Vec<(usize, f64)> {
-    row.iter().enumerate().filter(|(_, v)| **v != 0.0).map(|(c, &v)| (c, v)).collect()
+/// A sparse u-space row (global columns, any order, repeated columns summed) as the same
+/// linear form in q̇ (times T(q)): sorted by column, zeros left out.
+fn qdot_row(q: &[f64], entries: impl IntoIterator<Item = (usize, f64)>) -> Vec<(usize, f64)> {
+    let mut by_body: BTreeMap<usize, [f64; NQ]> = BTreeMap::new();
+    for (c, v) in entries {
+        by_body.entry(c / NQ).or_insert([0.0; NQ])[c % NQ] += v;
+    }
+    let blocks = by_body.into_iter().flat_map(|(b, mut r)| {
+        block_times_t(&q[NQ * b..NQ * (b + 1)], &mut r);
+        (0..NQ).map(move |c| (NQ * b + c, r[c]))
+    });
+    blocks.filter(|&(_, v)| v != 0.0).collect()
 }
 
 /// Where a velocity candidate comes from (the index relation to the position level).
@@ -66,12 +78,8 @@ pub fn select_velocities(
     for (k, v) in user_velocities(sys).into_iter().enumerate() {
         let j = &jets(sys, &v, q, u, &zeros, t, ext)[0];
         let nql = NQ * v.bodies.len();
-        let mut row = vec![0.0; n];
-        for a in 0..nql {
-            row[NQ * v.bodies[a / NQ] + a % NQ] = j.dg[nql + a];
-        }
-        row_times_t(q, &mut row);
-        push(0, VelState::User(v), VelOrigin::User(k), true, CandidateRow { entries: sparse(&row) })?;
+        let row = qdot_row(q, (0..nql).map(|a| (global_column(&v.bodies, a), j.dg[nql + a])));
+        push(0, VelState::User(v), VelOrigin::User(k), true, CandidateRow { entries: row })?;
     }
     for (i, Candidate { state: s, tier, user }) in pos.iter().enumerate() {
         // d/dt s(q) = s_q q̇: the position gradient is the q̇-row.
@@ -81,13 +89,12 @@ pub fn select_velocities(
     }
     let (mut fixed, mut nf) = constraint_rows(sys, q, t, ext);
     let (b, _) = nonholonomic_b(sys, q, u, t, ext);
-    let mut brows = vec![vec![0.0; n]; sys.mn];
+    let mut brows = vec![Vec::new(); sys.mn];
     for (r, c, v) in b {
-        brows[r][c] += v;
+        brows[r].push((c, v));
     }
-    for mut row in brows {
-        row_times_t(q, &mut row);
-        fixed.extend(sparse(&row).into_iter().map(|(c, v)| (nf, c, v)));
+    for row in brows {
+        fixed.extend(qdot_row(q, row).into_iter().map(|(c, v)| (nf, c, v)));
         nf += 1;
     }
     // Sparse complete pivoting (as at position level); the (independent) holonomic rows

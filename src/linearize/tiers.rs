@@ -11,7 +11,7 @@
 use crate::dae::rank::full_pivot;
 use crate::mechanics::System;
 use crate::mechanics::body::NQ;
-use crate::mechanics::kernels::constraint_first;
+use crate::mechanics::constraint_jacobian::{IndependentRows, constraint_jacobian};
 
 /// Weight W of candidate rows relative to constraint rows (Eq. 33's row weighting).
 pub const ROW_WEIGHT: f64 = 1e3;
@@ -33,20 +33,10 @@ pub fn gradient_row(bodies: &[usize], dg: &[f64]) -> CandidateRow {
 }
 
 /// The independent (non-redundant) rows of C_q at (q, t) as (row, col, value), and their
-/// number: the constraint rows F of every tier.
+/// number: the constraint rows F of every tier (redundant rows add no rank).
 pub fn constraint_rows(sys: &System, q: &[f64], t: f64, ext: &[f64]) -> (Vec<(usize, usize, f64)>, usize) {
-    let mut fixed = Vec::new();
-    let mut nf = 0;
-    for el in &sys.constraints {
-        let f = constraint_first(sys, el, q, t, ext);
-        let nql = NQ * el.bodies.len();
-        for e in (0..el.neq).filter(|e| !sys.redundant[el.row + e]) {
-            // (redundant rows are left out: they add no rank)
-            fixed.extend((0..nql).map(|a| (nf, NQ * el.bodies[a / NQ] + a % NQ, f.cq[e * nql + a])));
-            nf += 1;
-        }
-    }
-    (fixed, nf)
+    let rows = IndependentRows::of(sys);
+    (constraint_jacobian(sys, q, t, ext).independent(&rows).collect(), rows.count)
 }
 
 /// Why [`choose_in_tiers`] gave no choice.

@@ -48,11 +48,16 @@ pub fn h_transpose_times<T: Real>(q: &[T], w: &[T]) -> [T; NQ] {
 pub fn row_times_t(q: &[f64], r: &mut [f64]) {
     for b in 0..q.len() / NQ {
         let o = NQ * b;
-        let (st, ct, sp, cp) = (q[o + 4].sin(), q[o + 4].cos(), q[o + 5].sin(), q[o + 5].cos());
-        let t = [[st * sp, cp, 0.0], [st * cp, -sp, 0.0], [ct, 0.0, 1.0]];
-        let w = [r[o + 3], r[o + 4], r[o + 5]];
-        for c in 0..3 {
-            r[o + 3 + c] = (0..3).map(|k| w[k] * t[k][c]).sum();
-        }
+        block_times_t(&q[o..o + NQ], &mut r[o..o + NQ]);
+    }
+}
+
+/// One body's block `r` (6 entries) of a u-space row times T(q_b) (see [`row_times_t`]).
+pub fn block_times_t(qb: &[f64], r: &mut [f64]) {
+    let (st, ct, sp, cp) = (qb[4].sin(), qb[4].cos(), qb[5].sin(), qb[5].cos());
+    let t = [[st * sp, cp, 0.0], [st * cp, -sp, 0.0], [ct, 0.0, 1.0]];
+    let w = [r[3], r[4], r[5]];
+    for c in 0..3 {
+        r[3 + c] = (0..3).map(|k| w[k] * t[k][c]).sum();
     }
 }
