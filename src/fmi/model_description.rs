@@ -11,8 +11,7 @@ use std::fmt::Write as _;
 
 use super::guid::{ENGINE_VERSION, guid, model_identifier};
 use super::variables::{Causality, Target, Variable, variables};
-use crate::linearize::structure::{Dependencies, ModelStructure};
-use crate::linearize::{FmuLinearization, StateLayout, for_fmu};
+use crate::linearize::{Dependencies, FmuLinearization, ModelStructure, StateLayout, for_fmu};
 use crate::model::Model;
 
 /// The modelDescription.xml that `mbfmu pack` writes for `model`, whose file text is

@@ -11,8 +11,7 @@
 //! so both always agree.
 
 use crate::dae::DEFAULT_MAX_STEPS;
-use crate::linearize::StateLayout;
-use crate::linearize::states::derivative_name;
+use crate::linearize::{StateLayout, derivative_name};
 use crate::model::Model;
 use crate::model::units::per_second;
 

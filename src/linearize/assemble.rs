@@ -2,9 +2,9 @@
 //! one function per block of rows, pushed in this order. Rows and columns are placed
 //! through [`Eq34`] only.
 
-use super::augmented::OperatingPoint;
 use super::eq34::{Eq34, Equation, Unknown};
 use super::jets::jets;
+use super::operating_point::OperatingPoint;
 use crate::dae::equations::jacobian;
 use crate::dae::layout::Slot;
 use crate::dae::sparse::Triplets;

@@ -9,6 +9,8 @@
 use super::assemble::{Assembled, assemble};
 use super::eq34::Eq34;
 use super::extract::extract;
+use super::linearization::Linearization;
+use super::operating_point::OperatingPoint;
 use super::partition::check_partition;
 use super::rhs::RightHandSides;
 use super::select::Selection;
@@ -18,63 +20,6 @@ use crate::dae::sparse::SparseLu;
 use crate::dae::{EngineError, Simulator};
 use crate::mechanics::System;
 use crate::mechanics::constraint_jacobian::IndependentRows;
-use faer::Mat;
-
-/// A, B, C, D at one operating point, with the names of states, inputs and outputs.
-#[derive(Clone, Debug)]
-pub struct Linearization {
-    /// Time of the operating point.
-    pub time: f64,
-    /// State names: S, then W (`der(S)`), then the differential states X.
-    pub states: Vec<String>,
-    /// Input names, in the model's order.
-    pub inputs: Vec<String>,
-    /// Output names, in the model's order.
-    pub outputs: Vec<String>,
-    /// A (ns × ns), B (ns × ni), C (no × ns), D (no × ni), ns = s0 + s1 + nx.
-    pub a: Mat<f64>,
-    /// See [`Linearization::a`].
-    pub b: Mat<f64>,
-    /// See [`Linearization::a`].
-    pub c: Mat<f64>,
-    /// See [`Linearization::a`].
-    pub d: Mat<f64>,
-    /// Values of the states (S, W, X) at the operating point.
-    pub x: Vec<f64>,
-}
-
-/// The operating point of a linearization, and the layouts of the systems it reads.
-pub(super) struct OperatingPoint<'a> {
-    pub sys: &'a System,
-    pub sel: &'a Selection,
-    /// Layout of Eq. 34.
-    pub eq: Eq34,
-    /// Layout of the DAE, whose exact Jacobian gives most rows of Eq. 34.
-    pub lay: Layout,
-    /// The independent constraint rows (those of Eq. 34d–e).
-    pub rows: IndependentRows,
-    pub q: Vec<f64>,
-    pub u: Vec<f64>,
-    pub udot: Vec<f64>,
-    /// λ, then ν.
-    pub lam: Vec<f64>,
-    pub t: f64,
-    /// External values [inputs; Z; L] (see [`crate::mechanics::external::ExtLayout`]).
-    pub ext: Vec<f64>,
-}
-
-impl OperatingPoint<'_> {
-    /// Number of inputs v.
-    pub fn ni(&self) -> usize {
-        self.sys.ni()
-    }
-
-    /// The operating point as the output gradients take it.
-    pub fn point(&self) -> super::outputs::Point<'_> {
-        let (q, u, udot, lam) = (&self.q[..], &self.u[..], &self.udot[..], &self.lam[..]);
-        super::outputs::Point { q, u, udot, lam, t: self.t, inputs: &self.ext }
-    }
-}
 
 /// The layout of Eq. 34 for `sel` on `sys`, if its states complete the independent
 /// constraints to the coordinates (s0 + mr = n, s1 + mn = s0).

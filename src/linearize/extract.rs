@@ -2,7 +2,8 @@
 //! (of B) is (Ṡ, Ẇ, Ẋ) of the solution for state j (input j); C and D are the outputs'
 //! sensitivities in the same solutions, D plus the direct ∂y/∂v.
 
-use super::augmented::{Linearization, OperatingPoint};
+use super::linearization::Linearization;
+use super::operating_point::OperatingPoint;
 use super::sensitivity::Sensitivities;
 use crate::dae::EngineError;
 use faer::Mat;

@@ -10,6 +10,8 @@ pub mod eq34;
 pub mod extract;
 pub mod jets;
 pub mod layout;
+pub mod linearization;
+pub mod operating_point;
 pub mod outputs;
 pub mod partition;
 pub mod rhs;
@@ -21,11 +23,13 @@ pub mod structure;
 pub mod tiers;
 pub mod tolerances;
 
-pub use augmented::{Linearization, linearize};
+pub use augmented::linearize;
 pub use candidates::Candidates;
 pub use layout::{StateInfo, StateLayout, selection_by_name};
+pub use linearization::Linearization;
 pub use select::{Selection, select_states, select_states_among};
-pub use structure::ModelStructure;
+pub use states::derivative_name;
+pub use structure::{Dependencies, ModelStructure};
 
 use crate::dae::{EngineError, Simulator};
 use crate::model::Model;

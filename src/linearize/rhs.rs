@@ -3,8 +3,8 @@
 //! −∂r/∂v). Their solutions are the columns of A and B (Eq. 36).
 
 use super::assemble::equation_of;
-use super::augmented::OperatingPoint;
 use super::eq34::{Eq34, Equation};
+use super::operating_point::OperatingPoint;
 use crate::mechanics::constraint_jacobian::global_column;
 use crate::mechanics::kernels::{force_ext_jacobian, user_jacobian};
 

@@ -2,8 +2,8 @@
 //! column of A or B, Eq. 36) and the outputs' sensitivities (a column of C or D without
 //! the direct ∂y/∂v), by the chain rule through the q, u, u̇, λ and Z unknowns.
 
-use super::augmented::OperatingPoint;
 use super::eq34::{Eq34, Unknown};
+use super::operating_point::OperatingPoint;
 use super::outputs::{OutputGradient, output_gradient};
 use super::rhs::Column;
 use crate::mechanics::body::NQ;

@@ -10,6 +10,7 @@
 mod common;
 
 mod algebraic_loop;
+mod architecture;
 mod assembly;
 mod bicycle_benchmark;
 mod bounded_step;
