@@ -13,6 +13,7 @@ use super::input_csv::InputTable;
 use crate::dae::{BATCH_MAX_STEPS, SimOptions, Simulator};
 use crate::linearize::eigen::{eigen_table, format_table};
 use crate::linearize::{Linearization, Selection, linearize, selection_at_start, state_values};
+use crate::model::Model;
 use crate::model::parse::load_file;
 
 /// Integration tolerance when neither `--tol` nor the model's experiment gives one.
@@ -60,6 +61,34 @@ pub fn run(args: &LinearizeArgs, out: &mut dyn Write, report: &mut dyn Write) ->
     // --static: start from static equilibrium, as <analysis static="true"/> does.
     model.static_analysis |= args.r#static;
     let t0 = model.experiment.start.unwrap_or(0.0);
+    let (tol, times) = settings(args, &model, t0)?;
+    let (mut sim, table) = start(args, &mut model, tol, t0)?;
+    // The FMU's states: selected on their own configuration, not on this run's tolerance.
+    let sel = selection_at_start(&model)?;
+    let json_stdout = args.format == "json" && args.out.is_none();
+    let rep: &mut dyn Write = if json_stdout { &mut *report } else { &mut *out };
+    print_selection(&sel, rep).map_err(io_err)?;
+    if model.static_analysis {
+        print_equilibrium(&mut sim, &sel, t0, rep)?;
+    }
+    let mut results = Vec::new();
+    for &t in &times {
+        super::input_csv::advance(&mut sim, table.as_ref(), t)?;
+        let lin = linearize(&mut sim, &sel, args.threads)?;
+        print_eigenvalues(&lin, &sel, t, rep)?;
+        results.push(lin);
+    }
+    write_matrices(args, &results, out)
+}
+
+/// An error writing the report or the JSON to their stream.
+fn io_err(e: std::io::Error) -> CliError {
+    CliError::io("writing output", e)
+}
+
+/// The checked tolerance and the sorted operating times (from `--at`, else `t0`), after
+/// checking `--format`.
+fn settings(args: &LinearizeArgs, model: &Model, t0: f64) -> Result<(f64, Vec<f64>), CliError> {
     let tol = args.tol.or(model.experiment.tolerance).unwrap_or(DEFAULT_TOL);
     if tol.is_nan() || tol <= 0.0 {
         return Err(CliError::Usage(format!("--tol must be positive, got {tol}")));
@@ -72,50 +101,64 @@ pub fn run(args: &LinearizeArgs, out: &mut dyn Write, report: &mut dyn Write) ->
     if !matches!(args.format.as_str(), "table" | "json" | "npz" | "mat") {
         return Err(CliError::Usage(format!("--format {}: expected table, json, npz or mat", args.format)));
     }
-    let table = args.input.as_deref().map(|p| InputTable::read(p, &model)).transpose()?;
+    Ok((tol, times))
+}
+
+/// The simulator at `t0` (with the `--input` table's first values, which it returns) and
+/// its initialization warnings printed.
+fn start(
+    args: &LinearizeArgs,
+    model: &mut Model,
+    tol: f64,
+    t0: f64,
+) -> Result<(Simulator, Option<InputTable>), CliError> {
+    let table = args.input.as_deref().map(|p| InputTable::read(p, model)).transpose()?;
     if let Some(t) = &table {
-        t.set_start(&mut model, t0);
+        t.set_start(model, t0);
     }
-    let mut sim = Simulator::new(&model, SimOptions { tol, max_step: None, max_steps: args.max_steps }, t0)?;
+    let mut sim = Simulator::new(model, SimOptions { tol, max_step: None, max_steps: args.max_steps }, t0)?;
     if let Some(t) = &table {
         t.apply(&mut sim)?;
     }
     super::print_warnings(&sim);
-    // The FMU's states: selected on their own configuration, not on this run's tolerance.
-    let sel = selection_at_start(&model)?;
-    let io_err = |e| CliError::io("writing output", e);
-    let json_stdout = args.format == "json" && args.out.is_none();
-    let rep: &mut dyn Write = if json_stdout { &mut *report } else { &mut *out };
-    print_selection(&sel, rep).map_err(io_err)?;
-    if model.static_analysis {
-        let v = state_values(&mut sim, &sel)?;
-        let items: Vec<String> = sel.states.iter().zip(&v.s).map(|(s, x)| format!("{} = {x:.9e}", s.name)).collect();
-        writeln!(rep, "static equilibrium at t = {t0}: {}", items.join(", ")).map_err(io_err)?;
+    Ok((sim, table))
+}
+
+/// Print the selected states' values at the static equilibrium found at `t0`.
+fn print_equilibrium(sim: &mut Simulator, sel: &Selection, t0: f64, rep: &mut dyn Write) -> Result<(), CliError> {
+    let v = state_values(sim, sel)?;
+    let items: Vec<String> = sel.states.iter().zip(&v.s).map(|(s, x)| format!("{} = {x:.9e}", s.name)).collect();
+    writeln!(rep, "static equilibrium at t = {t0}: {}", items.join(", ")).map_err(io_err)?;
+    Ok(())
+}
+
+/// Print the eigenvalue table of the linearization `lin` at `t`, with a note on the zero
+/// eigenvalues that non-holonomic constraints imply.
+fn print_eigenvalues(lin: &Linearization, sel: &Selection, t: f64, rep: &mut dyn Write) -> Result<(), CliError> {
+    let rows = eigen_table(&lin.a).map_err(|e| CliError::Engine(e.into()))?;
+    writeln!(rep, "\nt = {t}: {} states, {} eigenvalues", lin.states.len(), lin.a.nrows()).map_err(io_err)?;
+    write!(rep, "{}", format_table(&rows)).map_err(io_err)?;
+    let (s0, s1) = (sel.states.len(), sel.velocities.len());
+    if s1 < s0 {
+        writeln!(
+            rep,
+            "note: at least s0 - s1 = {} eigenvalues are zero because of the non-holonomic constraints: \
+             {s0} position states but {s1} velocity states, so {} position combinations only integrate \
+             the velocities and never feed back",
+            s0 - s1,
+            s0 - s1
+        )
+        .map_err(io_err)?;
     }
-    let mut results = Vec::new();
-    for &t in &times {
-        super::input_csv::advance(&mut sim, table.as_ref(), t)?;
-        let lin = linearize(&mut sim, &sel, args.threads)?;
-        let rows = eigen_table(&lin.a).map_err(|e| CliError::Engine(e.into()))?;
-        writeln!(rep, "\nt = {t}: {} states, {} eigenvalues", lin.states.len(), lin.a.nrows()).map_err(io_err)?;
-        write!(rep, "{}", format_table(&rows)).map_err(io_err)?;
-        let (s0, s1) = (sel.states.len(), sel.velocities.len());
-        if s1 < s0 {
-            writeln!(
-                rep,
-                "note: at least s0 - s1 = {} eigenvalues are zero because of the non-holonomic constraints: \
-                 {s0} position states but {s1} velocity states, so {} position combinations only integrate \
-                 the velocities and never feed back",
-                s0 - s1,
-                s0 - s1
-            )
-            .map_err(io_err)?;
-        }
-        results.push(lin);
-    }
+    Ok(())
+}
+
+/// Write A, B, C, D of every linearization as `--format` asks: JSON to `--out` (else to
+/// `out`), npz or mat to `--out` (required); nothing for a table.
+fn write_matrices(args: &LinearizeArgs, results: &[Linearization], out: &mut dyn Write) -> Result<(), CliError> {
     match args.format.as_str() {
         "json" => {
-            let text = to_json(&results);
+            let text = to_json(results);
             match &args.out {
                 Some(p) => std::fs::write(p, text).map_err(|e| CliError::io(format!("writing {}", p.display()), e))?,
                 None => writeln!(out, "{text}").map_err(io_err)?,
@@ -123,7 +166,7 @@ pub fn run(args: &LinearizeArgs, out: &mut dyn Write, report: &mut dyn Write) ->
         }
         f @ ("npz" | "mat") => {
             let Some(p) = &args.out else { return Err(CliError::Usage(format!("--format {f} needs --out FILE"))) };
-            let bytes = if f == "npz" { super::matrices::npz(&results) } else { super::matrices::mat_v4(&results) };
+            let bytes = if f == "npz" { super::matrices::npz(results) } else { super::matrices::mat_v4(results) };
             std::fs::write(p, bytes?).map_err(|e| CliError::io(format!("writing {}", p.display()), e))?;
         }
         _ => {}

@@ -159,25 +159,16 @@ fn force_rows(at: &At, lc: &LoadChain, jac: &mut Triplets) {
 /// ∂/∂y of C (λ rows), Ċ (μ rows), −Pᵀλ (force balance) and −C_qᵀμ (q̇ rows); a
 /// redundant row has the identity (λ = μ = 0).
 fn constraint_rows(at: &At, jac: &mut Triplets) {
-    let (sys, q, u) = (at.sys, at.q, at.u);
-    let (nu, nl, nm) = (at.lay.u(), at.lay.lam(), at.lay.mu());
-    for el in &sys.constraints {
-        let s = constraint_second(sys, el, q, at.t, at.ext);
+    let (nl, nm) = (at.lay.lam(), at.lay.mu());
+    for el in &at.sys.constraints {
+        let s = constraint_second(at.sys, el, at.q, at.t, at.ext);
         let nql = NQ * el.bodies.len();
         let k = s.k;
-        let ql = gather(&el.bodies, q);
-        let ul = gather(&el.bodies, u);
-        let mut qd = vec![0.0; nql];
-        let mut dq = Vec::with_capacity(el.bodies.len());
-        for kb in 0..el.bodies.len() {
-            let r = NQ * kb..NQ * kb + NQ;
-            qd[r.clone()].copy_from_slice(&qdot(&ql[r.clone()], &ul[r.clone()]));
-            dq.push(dqdot_dq(&ql[r.clone()], &ul[r]));
-        }
+        let rates = body_rates(&el.bodies, at.q, at.u);
         let mut lq = vec![0.0; nql * nql];
         for e in 0..el.neq {
             let row = el.row + e;
-            if sys.redundant[row] {
+            if at.sys.redundant[row] {
                 jac.push(nl + row, nl + row, 1.0);
                 jac.push(nm + row, nm + row, 1.0);
                 continue;
@@ -185,48 +176,93 @@ fn constraint_rows(at: &At, jac: &mut Triplets) {
             let lam = at.y[nl + row];
             let g = &s.grad[e * k..(e + 1) * k];
             let hs = &s.hess[e * k * k..(e + 1) * k * k];
-            let p = p_row(&el.bodies, q, &g[..nql]);
-            for a in 0..nql {
-                let ga = global_column(&el.bodies, a);
-                // C_q (Eq. 13e rows), −C_qᵀ (q̇ rows, μ column), −Pᵀ (u rows, λ column), P (Ċ rows).
-                jac.push(nl + row, ga, g[a]);
-                jac.push(ga, nm + row, -g[a]);
-                jac.push(nu + ga, nl + row, -p[a]);
-                jac.push(nm + row, nu + ga, p[a]);
-                // Ċ_q = Σ_c C_qc,qa q̇_c + C_q ∂q̇/∂q_a + C_t,qa.
-                let kb = a / NQ;
-                let mut v = hs[a * k + nql];
-                for c in 0..nql {
-                    v += hs[c * k + a] * qd[c];
-                }
-                for c in 0..NQ {
-                    v += g[NQ * kb + c] * dq[kb][c * 6 + a % NQ];
-                }
-                jac.push(nm + row, ga, v);
-            }
+            constraint_row(at, &el.bodies, row, g, hs, &rates, jac);
             if lam != 0.0 {
-                // (Pᵀλ)_q = λ [Hᵀ ∂C_q/∂q + ∂(Hᵀ w)/∂q |_{w = C_q}].
-                for a in 0..nql {
-                    let col: Vec<f64> = (0..nql).map(|c| hs[c * k + a]).collect();
-                    let ht = p_row(&el.bodies, q, &col);
-                    for r in 0..nql {
-                        lq[r * nql + a] += lam * ht[r];
-                    }
-                }
-                for (kb, &b) in el.bodies.iter().enumerate() {
-                    let d = dhtw_dq(&q[NQ * b..NQ * b + NQ], &g[NQ * kb..NQ * kb + NQ]);
-                    for r in 0..NQ {
-                        for c in 0..NQ {
-                            lq[(NQ * kb + r) * nql + NQ * kb + c] += lam * d[r * 6 + c];
-                        }
-                    }
-                }
+                add_pt_lambda_q(&el.bodies, at.q, lam, g, hs, &mut lq);
             }
         }
+        push_pt_lambda_q(at, &el.bodies, &lq, jac);
+    }
+}
+
+/// q̇ = H(q) u of an element's bodies and ∂q̇/∂q of each body.
+struct BodyRates {
+    /// q̇, local (6 per body).
+    qd: Vec<f64>,
+    /// ∂q̇/∂q of each body (6 × 6, row-major).
+    dq: Vec<[f64; 36]>,
+}
+
+/// The [`BodyRates`] of `bodies` at global (q, u).
+fn body_rates(bodies: &[usize], q: &[f64], u: &[f64]) -> BodyRates {
+    let nql = NQ * bodies.len();
+    let ql = gather(bodies, q);
+    let ul = gather(bodies, u);
+    let mut qd = vec![0.0; nql];
+    let mut dq = Vec::with_capacity(bodies.len());
+    for kb in 0..bodies.len() {
+        let r = NQ * kb..NQ * kb + NQ;
+        qd[r.clone()].copy_from_slice(&qdot(&ql[r.clone()], &ul[r.clone()]));
+        dq.push(dqdot_dq(&ql[r.clone()], &ul[r]));
+    }
+    BodyRates { qd, dq }
+}
+
+/// The entries of one non-redundant constraint equation `row` with gradient `g` and
+/// Hessian `hs` (local q then t, k = g.len()): C_q in its λ row, −C_qᵀ in its μ column
+/// (q̇ rows), −Pᵀ in its λ column (u rows), P and Ċ_q in its μ row.
+fn constraint_row(at: &At, bodies: &[usize], row: usize, g: &[f64], hs: &[f64], rates: &BodyRates, jac: &mut Triplets) {
+    let (nu, nl, nm) = (at.lay.u(), at.lay.lam(), at.lay.mu());
+    let (nql, k) = (NQ * bodies.len(), g.len());
+    let p = p_row(bodies, at.q, &g[..nql]);
+    for a in 0..nql {
+        let ga = global_column(bodies, a);
+        // C_q (Eq. 13e rows), −C_qᵀ (q̇ rows, μ column), −Pᵀ (u rows, λ column), P (Ċ rows).
+        jac.push(nl + row, ga, g[a]);
+        jac.push(ga, nm + row, -g[a]);
+        jac.push(nu + ga, nl + row, -p[a]);
+        jac.push(nm + row, nu + ga, p[a]);
+        // Ċ_q = Σ_c C_qc,qa q̇_c + C_q ∂q̇/∂q_a + C_t,qa.
+        let kb = a / NQ;
+        let mut v = hs[a * k + nql];
+        for c in 0..nql {
+            v += hs[c * k + a] * rates.qd[c];
+        }
+        for c in 0..NQ {
+            v += g[NQ * kb + c] * rates.dq[kb][c * 6 + a % NQ];
+        }
+        jac.push(nm + row, ga, v);
+    }
+}
+
+/// Add one equation's (Pᵀλ)_q = λ [Hᵀ ∂C_q/∂q + ∂(Hᵀ w)/∂q |_{w = C_q}] to `lq` (local,
+/// row-major nql × nql), from its gradient `g` and Hessian `hs`.
+fn add_pt_lambda_q(bodies: &[usize], q: &[f64], lam: f64, g: &[f64], hs: &[f64], lq: &mut [f64]) {
+    let (nql, k) = (NQ * bodies.len(), g.len());
+    for a in 0..nql {
+        let col: Vec<f64> = (0..nql).map(|c| hs[c * k + a]).collect();
+        let ht = p_row(bodies, q, &col);
         for r in 0..nql {
-            for a in 0..nql {
-                jac.push(nu + global_column(&el.bodies, r), global_column(&el.bodies, a), -lq[r * nql + a]);
+            lq[r * nql + a] += lam * ht[r];
+        }
+    }
+    for (kb, &b) in bodies.iter().enumerate() {
+        let d = dhtw_dq(&q[NQ * b..NQ * b + NQ], &g[NQ * kb..NQ * kb + NQ]);
+        for r in 0..NQ {
+            for c in 0..NQ {
+                lq[(NQ * kb + r) * nql + NQ * kb + c] += lam * d[r * 6 + c];
             }
+        }
+    }
+}
+
+/// Push −(Pᵀλ)_q of an element (`lq`, local, from [`add_pt_lambda_q`]) into its bodies'
+/// u rows and q columns.
+fn push_pt_lambda_q(at: &At, bodies: &[usize], lq: &[f64], jac: &mut Triplets) {
+    let (nu, nql) = (at.lay.u(), NQ * bodies.len());
+    for r in 0..nql {
+        for a in 0..nql {
+            jac.push(nu + global_column(bodies, r), global_column(bodies, a), -lq[r * nql + a]);
         }
     }
 }

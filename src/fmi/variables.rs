@@ -94,6 +94,19 @@ pub struct Variable {
 /// ModelVariables order (index + 1 = FMI index).
 pub fn variables(model: &Model, lay: &StateLayout) -> Vec<Variable> {
     let mut v = Vec::new();
+    push_parameters(&mut v, model);
+    push_inputs(&mut v, model);
+    push_outputs(&mut v, model);
+    let first_sd = push_positions(&mut v, lay);
+    push_velocities(&mut v, lay, first_sd);
+    push_differentials(&mut v, model, lay.positions.len() + lay.velocities.len());
+    push_user_variables(&mut v, model);
+    push_max_steps(&mut v);
+    v
+}
+
+/// The model parameters (causality parameter, with start value, unit and description).
+fn push_parameters(v: &mut Vec<Variable>, model: &Model) {
     for (k, p) in model.parameters.iter().enumerate() {
         v.push(Variable {
             name: p.name.clone(),
@@ -108,6 +121,10 @@ pub fn variables(model: &Model, lay: &StateLayout) -> Vec<Variable> {
             unknown: None,
         });
     }
+}
+
+/// The model inputs (causality input, with start value and unit).
+fn push_inputs(v: &mut Vec<Variable>, model: &Model) {
     for (k, i) in model.inputs.iter().enumerate() {
         v.push(Variable {
             name: i.name.clone(),
@@ -122,6 +139,10 @@ pub fn variables(model: &Model, lay: &StateLayout) -> Vec<Variable> {
             unknown: None,
         });
     }
+}
+
+/// The model outputs (causality output, with unit).
+fn push_outputs(v: &mut Vec<Variable>, model: &Model) {
     for (k, o) in model.outputs.iter().enumerate() {
         v.push(Variable {
             name: o.name.clone(),
@@ -136,8 +157,12 @@ pub fn variables(model: &Model, lay: &StateLayout) -> Vec<Variable> {
             unknown: None,
         });
     }
-    let (s0, s1) = (lay.positions.len(), lay.velocities.len());
-    let var = |name: String, vr: usize, target: Target| Variable {
+}
+
+/// A local variable `name` with value reference `vr`, no start, unit, description, or
+/// linearization role yet.
+fn local(name: String, vr: usize, target: Target) -> Variable {
+    Variable {
         name,
         value_reference: vr as u32,
         causality: Causality::Local,
@@ -148,10 +173,16 @@ pub fn variables(model: &Model, lay: &StateLayout) -> Vec<Variable> {
         derivative: None,
         known: None,
         unknown: None,
-    };
+    }
+}
+
+/// The position states S (knowns 0..s0), then their derivatives der(S) (unknowns
+/// 0..s0); returns the 0-based index of the first der(S).
+fn push_positions(v: &mut Vec<Variable>, lay: &StateLayout) -> usize {
+    let s0 = lay.positions.len();
     let first_s = v.len();
     for (k, s) in lay.positions.iter().enumerate() {
-        let mut x = var(s.name.clone(), v.len(), Target::State(k));
+        let mut x = local(s.name.clone(), v.len(), Target::State(k));
         x.unit = s.unit.clone();
         x.description = Some(s.description.clone());
         x.known = Some(k);
@@ -162,13 +193,20 @@ pub fn variables(model: &Model, lay: &StateLayout) -> Vec<Variable> {
     for (k, s) in lay.positions.iter().enumerate() {
         let w = lay.velocity_of_state(k);
         let name = w.map_or_else(|| derivative_name(&s.name), |j| lay.velocities[j].name.clone());
-        let mut x = var(name, v.len(), Target::StateDerivative(k));
+        let mut x = local(name, v.len(), Target::StateDerivative(k));
         x.unit = s.unit.as_deref().and_then(per_second);
         x.derivative = Some(first_s + k + 1);
         x.known = w.map(|j| s0 + j);
         x.unknown = Some(k);
         v.push(x);
     }
+    first_sd
+}
+
+/// The velocity states W that are no der(S) (knowns s0 + j), then every der(W) (unknowns
+/// s0 + j); `first_sd` is the 0-based index of the first der(S).
+fn push_velocities(v: &mut Vec<Variable>, lay: &StateLayout, first_sd: usize) {
+    let (s0, s1) = (lay.positions.len(), lay.velocities.len());
     // 1-based index of each W_j's variable.
     let mut w_index = vec![0; s1];
     for (j, w) in w_index.iter_mut().enumerate() {
@@ -178,7 +216,7 @@ pub fn variables(model: &Model, lay: &StateLayout) -> Vec<Variable> {
     }
     for j in (0..s1).filter(|&j| lay.state_of_velocity(j).is_none()) {
         let w = &lay.velocities[j];
-        let mut x = var(w.name.clone(), v.len(), Target::Velocity(j));
+        let mut x = local(w.name.clone(), v.len(), Target::Velocity(j));
         x.unit = w.unit.clone();
         x.description = Some(w.description.clone());
         x.known = Some(s0 + j);
@@ -190,30 +228,43 @@ pub fn variables(model: &Model, lay: &StateLayout) -> Vec<Variable> {
             Some(k) => format!("der({},2)", lay.positions[k].name),
             None => derivative_name(&lay.velocities[j].name),
         };
-        let mut x = var(name, v.len(), Target::VelocityDerivative(j));
+        let mut x = local(name, v.len(), Target::VelocityDerivative(j));
         x.unit = lay.velocities[j].unit.as_deref().and_then(per_second);
         x.derivative = Some(wi);
         x.unknown = Some(s0 + j);
         v.push(x);
     }
+}
+
+/// The differential states X, then their derivatives der(X); `offset` = s0 + s1 is the
+/// known (and unknown) index of X_0 (of der(X_0)).
+fn push_differentials(v: &mut Vec<Variable>, model: &Model, offset: usize) {
     let first_x = v.len();
     for (k, d) in model.differentials.iter().enumerate() {
-        let mut x = var(d.name.clone(), v.len(), Target::Diff(k));
+        let mut x = local(d.name.clone(), v.len(), Target::Diff(k));
         x.description = Some("differential state (seed Eq. 7a)".into());
-        x.known = Some(s0 + s1 + k);
+        x.known = Some(offset + k);
         v.push(x);
     }
     for (k, d) in model.differentials.iter().enumerate() {
-        let mut x = var(derivative_name(&d.name), v.len(), Target::DiffDerivative(k));
+        let mut x = local(derivative_name(&d.name), v.len(), Target::DiffDerivative(k));
         x.derivative = Some(first_x + k + 1);
-        x.unknown = Some(s0 + s1 + k);
+        x.unknown = Some(offset + k);
         v.push(x);
     }
+}
+
+/// The user variables V (locals, no linearization role).
+fn push_user_variables(v: &mut Vec<Variable>, model: &Model) {
     for (k, d) in model.variables.iter().enumerate() {
-        let mut x = var(d.name.clone(), v.len(), Target::UserVariable(k));
+        let mut x = local(d.name.clone(), v.len(), Target::UserVariable(k));
         x.description = Some("user variable (seed Eq. 7b)".into());
         v.push(x);
     }
+}
+
+/// The Integer parameter [`MAX_STEPS_NAME`], last.
+fn push_max_steps(v: &mut Vec<Variable>) {
     v.push(Variable {
         name: MAX_STEPS_NAME.into(),
         value_reference: v.len() as u32,
@@ -230,5 +281,4 @@ pub fn variables(model: &Model, lay: &StateLayout) -> Vec<Variable> {
         known: None,
         unknown: None,
     });
-    v
 }

@@ -13,6 +13,7 @@
 //! is itself a dual-number derivative, so constraint loads nest two levels).
 
 use super::body::{NQ, h_transpose_times};
+use super::constraint_jacobian::global_column;
 use super::constraints::{ConstraintEl, ConstraintKind};
 use super::forces::ForceEl;
 use super::kernels::gather;
@@ -65,7 +66,7 @@ impl LoadGradient {
     pub fn terms(&self, c: usize, mut f: impl FnMut(LoadTerm, f64)) {
         let nlb = NQ * self.bodies.len();
         for a in 0..nlb {
-            let g = NQ * self.bodies[a / NQ] + a % NQ;
+            let g = global_column(&self.bodies, a);
             f(LoadTerm::Q(g), self.dz[c * 2 * nlb + a]);
             f(LoadTerm::U(g), self.dz[c * 2 * nlb + nlb + a]);
         }

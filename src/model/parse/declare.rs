@@ -157,10 +157,7 @@ impl<'a> Loader<'a> {
         r: ElementRef,
         idx: usize,
     ) -> Result<(), ModelError> {
-        let mut ns = std::mem::take(self.namespace(kind));
-        let res = self.declare(&mut ns, x, kind, idx, false);
-        *self.namespace(kind) = ns;
-        let name = res?;
+        let name = self.declare_in(x, kind, idx)?;
         if let Some(&(_, prev, line)) = self.scope.elements.get(&name) {
             let el = self.el(x);
             let at = el.get("name").map_or(x.pos, |a| a.pos);
@@ -202,111 +199,98 @@ impl<'a> Loader<'a> {
         let mut n = Counts::default();
         for x in &root.children {
             self.check_element(x, "multibody")?;
-            match x.tag.as_str() {
-                "parameter" => {
-                    self.declare_bare(x, "parameter", NameRef::Param(n.params))?;
-                    n.params += 1;
-                }
-                "input" => {
-                    self.declare_bare(x, "input", NameRef::Input(n.inputs))?;
-                    n.inputs += 1;
-                }
-                "body" => {
-                    let mut ns = std::mem::take(&mut self.ns_bodies);
-                    let res = self.declare(&mut ns, x, "body", n.bodies, false);
-                    self.ns_bodies = ns;
-                    let name = res?;
-                    let cm = self.scope.marker_body.len();
-                    self.scope.marker_body.push(Some(n.bodies));
-                    self.scope.markers.insert(format!("{name}.cm"), cm);
-                    self.scope.body_cm.insert(name.clone(), cm);
-                    self.scope.body_names.push(name.clone());
-                    self.declare_markers(x, &name, Some(n.bodies))?;
-                    n.bodies += 1;
-                }
-                "ground" => {
-                    self.once(x)?;
-                    self.declare_markers(x, "ground", None)?;
-                }
-                "joint" => {
-                    self.declare_element(x, "joint", ElementRef::Joint(n.joints), n.joints)?;
-                    n.joints += 1;
-                }
-                "motion" => {
-                    self.declare_element(x, "motion", ElementRef::Motion(n.motions), n.motions)?;
-                    n.motions += 1;
-                }
-                "constraint" => {
-                    let r = ElementRef::Constraint(n.constraints);
-                    self.declare_element(x, "constraint", r, n.constraints)?;
-                    n.constraints += 1;
-                }
-                "spring_damper" => {
-                    let r = ElementRef::SpringDamper(n.springs);
-                    self.declare_element(x, "force", r, n.forces)?;
-                    n.springs += 1;
-                    n.forces += 1;
-                }
-                "sforce" => {
-                    self.declare_element(x, "force", ElementRef::Sforce(n.sforces), n.forces)?;
-                    n.sforces += 1;
-                    n.forces += 1;
-                }
-                "gforce" => {
-                    self.declare_element(x, "force", ElementRef::Gforce(n.gforces), n.forces)?;
-                    n.gforces += 1;
-                    n.forces += 1;
-                }
-                "bushing" => {
-                    self.declare_element(x, "force", ElementRef::Bushing(n.bushings), n.forces)?;
-                    n.bushings += 1;
-                    n.forces += 1;
-                }
-                "rolling_wheel" | "knife_edge" | "velocity_constraint" => {
-                    let mut ns = std::mem::take(&mut self.ns_nonholonomic);
-                    let res = self.declare(&mut ns, x, "non-holonomic constraint", n.nonholonomic, false);
-                    self.ns_nonholonomic = ns;
-                    res?;
-                    n.nonholonomic += 1;
-                }
-                "variable" => {
-                    self.declare_bare(x, "variable", NameRef::Variable(n.variables))?;
-                    n.variables += 1;
-                }
-                "differential" => {
-                    self.declare_bare(x, "differential", NameRef::Diff(n.diffs))?;
-                    n.diffs += 1;
-                }
-                "output" => {
-                    let mut ns = std::mem::take(&mut self.ns_outputs);
-                    let res = self.declare(&mut ns, x, "output", n.outputs, false);
-                    self.ns_outputs = ns;
-                    res?;
-                    n.outputs += 1;
-                }
-                "linearization" => {
-                    self.once(x)?;
-                    for c in &x.children {
-                        let mut ns = std::mem::take(&mut self.ns_lin);
-                        let res = self.declare(&mut ns, c, "linearization state", n.lin, false);
-                        self.ns_lin = ns;
-                        res?;
-                        n.lin += 1;
-                    }
-                }
-                "gravity" | "experiment" | "analysis" => self.once(x)?,
-                _ => {}
-            }
+            self.declare_child(x, &mut n)?;
         }
         Ok(())
     }
 
-    /// The namespace of a kind of element with a load-function name.
+    /// Declare the names of one child of the root, numbered among its kind by `n`.
+    fn declare_child(&mut self, x: &'a XElem, n: &mut Counts) -> Result<(), ModelError> {
+        match x.tag.as_str() {
+            "parameter" => self.declare_bare(x, "parameter", NameRef::Param(next(&mut n.params))),
+            "input" => self.declare_bare(x, "input", NameRef::Input(next(&mut n.inputs))),
+            "body" => self.declare_body(x, next(&mut n.bodies)),
+            "ground" => self.declare_ground(x),
+            "joint" => {
+                let k = next(&mut n.joints);
+                self.declare_element(x, "joint", ElementRef::Joint(k), k)
+            }
+            "motion" => {
+                let k = next(&mut n.motions);
+                self.declare_element(x, "motion", ElementRef::Motion(k), k)
+            }
+            "constraint" => {
+                let k = next(&mut n.constraints);
+                self.declare_element(x, "constraint", ElementRef::Constraint(k), k)
+            }
+            "spring_damper" => {
+                let r = ElementRef::SpringDamper(next(&mut n.springs));
+                self.declare_element(x, "force", r, next(&mut n.forces))
+            }
+            "sforce" => self.declare_element(x, "force", ElementRef::Sforce(next(&mut n.sforces)), next(&mut n.forces)),
+            "gforce" => self.declare_element(x, "force", ElementRef::Gforce(next(&mut n.gforces)), next(&mut n.forces)),
+            "bushing" => {
+                let r = ElementRef::Bushing(next(&mut n.bushings));
+                self.declare_element(x, "force", r, next(&mut n.forces))
+            }
+            "rolling_wheel" | "knife_edge" | "velocity_constraint" => {
+                self.declare_in(x, "non-holonomic constraint", next(&mut n.nonholonomic)).map(drop)
+            }
+            "variable" => self.declare_bare(x, "variable", NameRef::Variable(next(&mut n.variables))),
+            "differential" => self.declare_bare(x, "differential", NameRef::Diff(next(&mut n.diffs))),
+            "output" => self.declare_in(x, "output", next(&mut n.outputs)).map(drop),
+            "linearization" => self.declare_linearization(x, &mut n.lin),
+            "gravity" | "experiment" | "analysis" => self.once(x),
+            _ => Ok(()),
+        }
+    }
+
+    /// `<body>` number `idx`: its name, its `cm` marker (numbered first), then its own
+    /// markers.
+    fn declare_body(&mut self, x: &'a XElem, idx: usize) -> Result<(), ModelError> {
+        let name = self.declare_in(x, "body", idx)?;
+        let cm = self.scope.marker_body.len();
+        self.scope.marker_body.push(Some(idx));
+        self.scope.markers.insert(format!("{name}.cm"), cm);
+        self.scope.body_cm.insert(name.clone(), cm);
+        self.scope.body_names.push(name.clone());
+        self.declare_markers(x, &name, Some(idx))
+    }
+
+    /// `<ground>` (once only): its markers, on no body.
+    fn declare_ground(&mut self, x: &'a XElem) -> Result<(), ModelError> {
+        self.once(x)?;
+        self.declare_markers(x, "ground", None)
+    }
+
+    /// `<linearization>` (once only): its states and velocities, numbered on from `n`.
+    fn declare_linearization(&mut self, x: &'a XElem, n: &mut usize) -> Result<(), ModelError> {
+        self.once(x)?;
+        for c in &x.children {
+            self.declare_in(c, "linearization state", next(n))?;
+        }
+        Ok(())
+    }
+
+    /// Check the `name` of `x` and declare it in the namespace of `kind` (see
+    /// [`Self::namespace`]); returns the name.
+    fn declare_in(&mut self, x: &'a XElem, kind: &str, idx: usize) -> Result<String, ModelError> {
+        let mut ns = std::mem::take(self.namespace(kind));
+        let res = self.declare(&mut ns, x, kind, idx, false);
+        *self.namespace(kind) = ns;
+        res
+    }
+
+    /// The namespace of a kind of named element (every other kind: forces).
     fn namespace(&mut self, kind: &str) -> &mut Namespace {
         match kind {
+            "body" => &mut self.ns_bodies,
             "joint" => &mut self.ns_joints,
             "motion" => &mut self.ns_motions,
             "constraint" => &mut self.ns_constraints,
+            "non-holonomic constraint" => &mut self.ns_nonholonomic,
+            "output" => &mut self.ns_outputs,
+            "linearization state" => &mut self.ns_lin,
             _ => &mut self.ns_forces,
         }
     }
@@ -317,6 +301,7 @@ impl<'a> Loader<'a> {
     }
 }
 
+/// How many elements of each kind the first pass has numbered so far.
 #[derive(Default)]
 struct Counts {
     params: usize,
@@ -335,4 +320,11 @@ struct Counts {
     forces: usize,
     outputs: usize,
     lin: usize,
+}
+
+/// The next number of a count: its current value, then one more.
+fn next(count: &mut usize) -> usize {
+    let k = *count;
+    *count += 1;
+    k
 }

@@ -4,11 +4,15 @@
 //! One concept per file: `source` (positions), `xml` (element tree), `attrs`
 //! (attributes, vectors, constants), `orient` (orientations), `names` (names and
 //! the expression scope), `params` (parameter evaluation order), `declare` and
-//! `build` (the two passes over elements), `validate` (value and level checks),
+//! `build` (the two passes over elements; `build_constraints`, `build_forces` and
+//! `build_user` build each family of elements), `validate` (value and level checks),
 //! `model_impl` (queries on a loaded model).
 
 mod attrs;
 mod build;
+mod build_constraints;
+mod build_forces;
+mod build_user;
 mod declare;
 mod load;
 mod model_impl;
