@@ -66,8 +66,9 @@ def pack_model(model: Path, dest: Path) -> Packed:
 
 def simulate_cli(model: Path, out: Path, end: float, step: float, tol: float) -> tuple[list, list]:
     """`mbfmu simulate`: (header, rows of floats)."""
-    r = run_mbfmu("simulate", str(model), "--end", repr(end), "--step", repr(step), "--tol", repr(tol),
-                  "--out", str(out))
+    r = run_mbfmu(
+        "simulate", str(model), "--end", repr(end), "--step", repr(step), "--tol", repr(tol), "--out", str(out)
+    )
     assert r.returncode == 0, r.stderr
     with open(out, newline="") as f:
         rows = list(csv.reader(f))
@@ -110,17 +111,23 @@ class LogCapture:
 # --- instances ----------------------------------------------------------------------
 
 
-def new_slave(p: Packed, name: str = "inst", unzipped: Path | None = None, log: LogCapture | None = None,
-              logging_on: bool = False) -> FMU2Slave:
+def new_slave(
+    p: Packed, name: str = "inst", unzipped: Path | None = None, log: LogCapture | None = None, logging_on: bool = False
+) -> FMU2Slave:
     """An instantiated FMU2Slave (each loads the shared library of its unzip directory)."""
-    s = FMU2Slave(guid=p.md.guid, unzipDirectory=str(unzipped or p.unzipped),
-                  modelIdentifier=p.md.coSimulation.modelIdentifier, instanceName=name)
+    s = FMU2Slave(
+        guid=p.md.guid,
+        unzipDirectory=str(unzipped or p.unzipped),
+        modelIdentifier=p.md.coSimulation.modelIdentifier,
+        instanceName=name,
+    )
     s.instantiate(loggingOn=logging_on, callbacks=None if log is None else log.callbacks)
     return s
 
 
-def initialize(s: FMU2Slave, tol: float, start: float = 0.0, stop: float | None = None,
-               values: dict | None = None) -> None:
+def initialize(
+    s: FMU2Slave, tol: float, start: float = 0.0, stop: float | None = None, values: dict | None = None
+) -> None:
     """setupExperiment, the values (vr -> value) in initialization mode, exit."""
     s.setupExperiment(tolerance=tol, startTime=start, stopTime=stop)
     s.enterInitializationMode()

@@ -42,7 +42,12 @@ def discarded(call, log: LogCapture) -> str:
 def test_the_model_description_declares_solver_max_steps_last(toggle):
     v = toggle.md.modelVariables[-1]
     assert (v.name, v.type, v.causality, v.variability, v.initial) == (
-        "solver.maxSteps", "Integer", "parameter", "tunable", "exact")
+        "solver.maxSteps",
+        "Integer",
+        "parameter",
+        "tunable",
+        "exact",
+    )
     assert int(v.start) == DEFAULT_MAX_STEPS
     assert v.valueReference == len(toggle.md.modelVariables) - 1
     assert "fmi2Discard" in v.description

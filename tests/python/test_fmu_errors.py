@@ -127,8 +127,13 @@ def test_a_state_of_another_fmu_or_garbage_is_refused(logged, packed):
     finally:
         other.terminate()
         other.freeInstance()
-    refused(lambda: s.deSerializeFMUstate(foreign), "fmi2DeSerializeFMUstate", log, "belongs to FMU",
-            packed("pendulum").md.guid)
+    refused(
+        lambda: s.deSerializeFMUstate(foreign),
+        "fmi2DeSerializeFMUstate",
+        log,
+        "belongs to FMU",
+        packed("pendulum").md.guid,
+    )
     refused(lambda: s.deSerializeFMUstate(b"garbage"), "fmi2DeSerializeFMUstate", log, "not a serialized state")
     own = s.getFMUstate()
     restored = s.deSerializeFMUstate(s.serializeFMUstate(own))
@@ -143,8 +148,11 @@ def test_assembly_that_moves_a_body_far_is_logged_as_a_warning(tmp_path):
     # position is assembled away, and the instance logs which body moved and how far.
     from fmu_helpers import MODELS, LogCapture, initialize, new_slave, pack_model
 
-    text = (MODELS / "double_pendulum.xml").read_text().replace(
-        'position="-L*sin(th1) - L/2*sin(th2), 0,', 'position="0.2 - L*sin(th1) - L/2*sin(th2), 0,')
+    text = (
+        (MODELS / "double_pendulum.xml")
+        .read_text()
+        .replace('position="-L*sin(th1) - L/2*sin(th2), 0,', 'position="0.2 - L*sin(th1) - L/2*sin(th2), 0,')
+    )
     model = tmp_path / "double_pendulum_typo.xml"
     model.write_text(text)
     p = pack_model(model, tmp_path)

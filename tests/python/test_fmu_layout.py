@@ -5,16 +5,21 @@ is packed with a warning that says why."""
 
 import shutil
 
-import mbfmu
 import pytest
 from fmpy import read_model_description
 from fmpy.fmi2 import FMU2Slave
+
+import mbfmu
 from fmu_helpers import MODELS, LogCapture, pack_model
 
 
 def instantiate(p, unzipped, log):
-    s = FMU2Slave(guid=p.md.guid, unzipDirectory=str(unzipped), modelIdentifier=p.md.coSimulation.modelIdentifier,
-                  instanceName="layout")
+    s = FMU2Slave(
+        guid=p.md.guid,
+        unzipDirectory=str(unzipped),
+        modelIdentifier=p.md.coSimulation.modelIdentifier,
+        instanceName="layout",
+    )
     s.instantiate(callbacks=log.callbacks)
     return s
 
@@ -30,8 +35,11 @@ def test_a_missing_or_foreign_state_layout_fails_instantiation_with_the_reason_l
     other = pack_model(MODELS / "double_pendulum.xml", tmp_path)
     for name, change, reason in [
         ("missing", lambda d: (d / "resources" / "states.txt").unlink(), "cannot read"),
-        ("foreign", lambda d: shutil.copy(other.unzipped / "resources" / "states.txt", d / "resources"),
-         "belongs to the model of GUID " + other.md.guid),
+        (
+            "foreign",
+            lambda d: shutil.copy(other.unzipped / "resources" / "states.txt", d / "resources"),
+            "belongs to the model of GUID " + other.md.guid,
+        ),
     ]:
         d = tmp_path / name
         shutil.copytree(p.unzipped, d)
@@ -45,8 +53,9 @@ def test_a_missing_or_foreign_state_layout_fails_instantiation_with_the_reason_l
 
 
 def test_a_model_that_cannot_be_assembled_packs_with_a_located_warning(tmp_path):
-    text = (MODELS / "fourbar.xml").read_text().replace('<parameter name="a" value="0.2"',
-                                                       '<parameter name="a" value="5"')
+    text = (
+        (MODELS / "fourbar.xml").read_text().replace('<parameter name="a" value="0.2"', '<parameter name="a" value="5"')
+    )
     model = tmp_path / "fourbar_long.xml"
     model.write_text(text)
     located = r"no linearization states.*fourbar_long\.xml:\d+:\d+: joint 'rocker_pin'"

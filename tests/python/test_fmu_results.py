@@ -22,8 +22,7 @@ def test_simulate_fmu_equals_mbfmu_simulate_at_common_times(name, packed, tmp_pa
     # CS FMU, and without it would use the DefaultExperiment tolerance (the model's, 1e-6):
     # pass it explicitly so both runs use TOL. For CS, output_interval is the communication
     # step; fmpy's points are start + k * output_interval, as the CLI's.
-    res = simulate_fmu(str(p.fmu), relative_tolerance=TOL, output_interval=STEP, stop_time=END,
-                       output=p.outputs)
+    res = simulate_fmu(str(p.fmu), relative_tolerance=TOL, output_interval=STEP, stop_time=END, output=p.outputs)
     fmu_t = res["time"]
     cli = np.array(rows)
     assert len(fmu_t) == len(cli) == round(END / STEP) + 1

@@ -8,8 +8,9 @@ import sys
 from ctypes import byref, c_double, c_uint, c_void_p
 
 import pytest
-from fmu_helpers import MODELS, LogCapture, _Logger6, fmi2CallbackLoggerTYPE, initialize, new_slave
 from fmpy.fmi2 import FMU2Slave
+
+from fmu_helpers import MODELS, LogCapture, _Logger6, fmi2CallbackLoggerTYPE, initialize, new_slave
 
 FMI_ERROR = 3
 
@@ -113,8 +114,12 @@ def test_a_logger_that_calls_back_into_the_instance_gets_fmi2error(packed):
     cap = LogCapture()
     fn = _Logger6(log)
     cap.callbacks.logger = fmi2CallbackLoggerTYPE(c_void_p.from_buffer(fn).value)
-    s = FMU2Slave(guid=p.md.guid, unzipDirectory=str(p.unzipped), modelIdentifier=p.md.coSimulation.modelIdentifier,
-                  instanceName="reentrant")
+    s = FMU2Slave(
+        guid=p.md.guid,
+        unzipDirectory=str(p.unzipped),
+        modelIdentifier=p.md.coSimulation.modelIdentifier,
+        instanceName="reentrant",
+    )
     holder["slave"] = s
     s.instantiate(callbacks=cap.callbacks)
     try:
@@ -168,8 +173,12 @@ def test_a_freed_component_is_refused_not_dereferenced(packed):
     p = packed("pendulum")
     # A second load of the same library keeps it mapped after fmpy's freeInstance
     # unloads its own (dlopen counts references).
-    keeper = FMU2Slave(guid=p.md.guid, unzipDirectory=str(p.unzipped),
-                       modelIdentifier=p.md.coSimulation.modelIdentifier, instanceName="keeper")
+    keeper = FMU2Slave(
+        guid=p.md.guid,
+        unzipDirectory=str(p.unzipped),
+        modelIdentifier=p.md.coSimulation.modelIdentifier,
+        instanceName="keeper",
+    )
     s = new_slave(p, "freed")
     initialize(s, 1e-8)
     dead = s.component

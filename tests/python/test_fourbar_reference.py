@@ -53,7 +53,7 @@ def d5(fun, x, h=1e-3):
 
 def model_fns(psi_guess):
     masses = [RHO * A_, RHO * B_, RHO * C_]
-    inertias = [m * l * l / 12 for m, l in zip(masses, [A_, B_, C_])]
+    inertias = [m * length * length / 12 for m, length in zip(masses, [A_, B_, C_], strict=True)]
 
     def kin(phi):
         return geometry(phi, psi_guess)
@@ -77,7 +77,7 @@ def model_fns(psi_guess):
 
     def potential(phi):
         cms = kin(phi)[0]
-        return G * sum(m * cm[1] for m, cm in zip(masses, cms))
+        return G * sum(m * cm[1] for m, cm in zip(masses, cms, strict=True))
 
     def f(phi, phid):
         return -(0.5 * d5(mass, phi) * phid * phid + d5(potential, phi)) / mass(phi)

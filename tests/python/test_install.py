@@ -17,8 +17,9 @@ def test_installed_mbfmu_packs_from_an_empty_directory_and_fmpy_runs_the_fmu(tmp
     env = {k: v for k, v in os.environ.items() if k != "MBFMU_LIB"}
     env["PATH"] = f"{prefix / 'bin'}:{env.get('PATH', '')}"
     (work / "pendulum.xml").write_text((MODELS / "pendulum.xml").read_text())
-    r = subprocess.run(["mbfmu", "pack", "pendulum.xml", "-o", "pendulum.fmu"], cwd=work, env=env,
-                       capture_output=True, text=True)
+    r = subprocess.run(
+        ["mbfmu", "pack", "pendulum.xml", "-o", "pendulum.fmu"], cwd=work, env=env, capture_output=True, text=True
+    )
     assert r.returncode == 0, r.stderr
     res = simulate_fmu(str(work / "pendulum.fmu"), stop_time=0.5, output_interval=0.1)
     assert len(res) == 6 and abs(res["time"][-1] - 0.5) < 1e-12

@@ -65,33 +65,40 @@ def test_packed_fmu_validates(model: Path, tmp_path: Path):
     # der(W)), then X, der(X), V, and last the Integer solver.maxSteps; value references
     # 0, 1, 2, ...
     root = ET.parse(model).getroot()
-    expected = [(e.get("name"), c) for tag, c in (("parameter", "parameter"), ("input", "input"), ("output", "output"))
-                for e in root.iter(tag)]
+    expected = [
+        (e.get("name"), c)
+        for tag, c in (("parameter", "parameter"), ("input", "input"), ("output", "output"))
+        for e in root.iter(tag)
+    ]
     last = md.modelVariables[-1]
     assert (last.name, last.type, last.causality, last.variability) == (
-        "solver.maxSteps", "Integer", "parameter", "tunable")
+        "solver.maxSteps",
+        "Integer",
+        "parameter",
+        "tunable",
+    )
     assert all(v.type == "Real" for v in md.modelVariables[:-1])
     actual = [(v.name, v.causality) for v in md.modelVariables[:-1]]
     assert actual[: len(expected)] == expected
-    local = [name for name, c in actual[len(expected):]]
-    assert all(c == "local" for _, c in actual[len(expected):])
+    local = [name for name, c in actual[len(expected) :]]
+    assert all(c == "local" for _, c in actual[len(expected) :])
     # ... then differential states X, der(X) and user variables V last.
     diffs = [e.get("name") for e in root.iter("differential")]
     tail = diffs + [f"der({d})" for d in diffs] + [e.get("name") for e in root.iter("variable")]
-    assert local[len(local) - len(tail):] == tail
+    assert local[len(local) - len(tail) :] == tail
     lin = local[: len(local) - len(tail)]
     # Linearization states: S, der(S), velocity states that are no der(S) (non-holonomic
     # models), then der(W) (named der(S,2) where W = der(S)).
     # (Model names have no parentheses: S and W are the names that are no der(...).)
     descr = {v.name: v.description for v in md.modelVariables}
     s = next((k for k, n in enumerate(lin) if n.startswith("der(")), len(lin))
-    assert lin[s:2 * s] == [f"der({n})" for n in lin[:s]]
-    extra = [n for n in lin[2 * s:] if not n.startswith("der(")]
-    assert lin[2 * s:2 * s + len(extra)] == extra
+    assert lin[s : 2 * s] == [f"der({n})" for n in lin[:s]]
+    extra = [n for n in lin[2 * s :] if not n.startswith("der(")]
+    assert lin[2 * s : 2 * s + len(extra)] == extra
     # Each S and W says what it measures.
     assert all(descr[n] for n in lin[:s] + extra)
     if not root.findall("rolling_wheel") + root.findall("knife_edge") + root.findall("velocity_constraint"):
-        assert extra == [] and lin[2 * s:] == [f"der({n},2)" for n in lin[:s]]
+        assert extra == [] and lin[2 * s :] == [f"der({n},2)" for n in lin[:s]]
     assert [v.valueReference for v in md.modelVariables] == list(range(len(actual) + 1))
     assert md.defaultExperiment is not None
 
