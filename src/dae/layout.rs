@@ -72,6 +72,12 @@ impl Layout {
     pub fn acc(&self) -> usize {
         self.z() + 2 * self.nx + self.nv
     }
+    /// Where in Z (not y) the accelerations of the k-th body with acceleration unknowns
+    /// (`System::acc_bodies[k]`) live: 6 entries, v̇ then ω̇'.
+    pub fn acc_in_z(&self, k: usize) -> Range<usize> {
+        let a0 = 2 * self.nx + self.nv + NQ * k;
+        a0..a0 + NQ
+    }
     /// Offset of λ.
     pub fn lam(&self) -> usize {
         self.z() + self.nz()

@@ -156,9 +156,8 @@ impl Simulator {
         let mut z = self.user_values().to_vec();
         // Acceleration unknowns: those of the same solve as λ.
         if let Some((udot, _)) = &self.acc {
-            let a0 = lay.acc() - lay.z();
             for (k, &b) in self.dae.sys.acc_bodies.iter().enumerate() {
-                z[a0 + NQ * k..a0 + NQ * (k + 1)].copy_from_slice(&udot[NQ * b..NQ * (b + 1)]);
+                z[lay.acc_in_z(k)].copy_from_slice(&udot[NQ * b..NQ * (b + 1)]);
             }
         }
         self.dae.sys.ext(&self.dae.inputs_at(t), &z, Some(state), t)
