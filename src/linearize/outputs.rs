@@ -11,7 +11,9 @@ use crate::mechanics::body::NQ;
 use crate::mechanics::kernels::gather;
 use crate::mechanics::loads::{LoadTerm, NLOAD, load_gradient, load_index, load_value};
 use crate::mechanics::local::LocalCtx;
+use crate::model::MAX_ELEMENT_BODIES;
 use crate::model::expr::{ElementRef, Expr, LoadFn, deps};
+use std::ops::Range;
 
 /// Gradient of one output: its bodies, ∂y/∂(q, u, u̇) local (18·nb: q of every body,
 /// then u, then u̇), ∂y/∂λ as (global row, value) pairs, and ∂y/∂v per input.
@@ -48,13 +50,7 @@ pub fn output_gradient(sys: &System, e: &Expr, abase: usize, p: Point) -> Output
     let value_of = |f: LoadFn, r: ElementRef| -> f64 {
         loads.iter().find(|(x, _)| *x == r).map_or(f64::NAN, |(_, v)| v[load_index(f)])
     };
-    let dz_own = match own.len() {
-        0 => grad_k::<1>(sys, e, abase, &own, p, &value_of),
-        1 => grad_k::<18>(sys, e, abase, &own, p, &value_of),
-        2 => grad_k::<36>(sys, e, abase, &own, p, &value_of),
-        3 => grad_k::<54>(sys, e, abase, &own, p, &value_of),
-        _ => grad_k::<72>(sys, e, abase, &own, p, &value_of),
-    };
+    let dz_own = own_gradient(sys, e, abase, &own, p, &value_of);
     let lift = |x: Vec<f64>| -> Vec<Dual<f64, 1>> { x.into_iter().map(Dual::cst).collect() };
     let mut dv: Vec<f64> = (0..p.inputs.len())
         .map(|k| {
@@ -130,23 +126,58 @@ fn load_sensitivity(
     ctx.eval_expr(e, abase).d
 }
 
-/// ∂y/∂(local q, u, u̇) of the output's own kinematic measures, loads held constant.
+/// ∂y/∂(local q, u, u̇) of the output's own kinematic measures (q of every body of `own`,
+/// then u, then u̇), loads held constant. An output may measure any number of bodies:
+/// they are seeded [`MAX_ELEMENT_BODIES`] at a time (the widest dual number), the others
+/// held constant.
+fn own_gradient(
+    sys: &System,
+    e: &Expr,
+    abase: usize,
+    own: &[usize],
+    p: Point,
+    value_of: &dyn Fn(LoadFn, ElementRef) -> f64,
+) -> Vec<f64> {
+    let n_own = NQ * own.len();
+    let mut dz = vec![0.0; 3 * n_own];
+    for start in (0..own.len()).step_by(MAX_ELEMENT_BODIES) {
+        let seeded = start..own.len().min(start + MAX_ELEMENT_BODIES);
+        let g = match seeded.len() {
+            1 => grad_k::<18>(sys, e, abase, own, seeded.clone(), p, value_of),
+            2 => grad_k::<36>(sys, e, abase, own, seeded.clone(), p, value_of),
+            3 => grad_k::<54>(sys, e, abase, own, seeded.clone(), p, value_of),
+            _ => grad_k::<72>(sys, e, abase, own, seeded.clone(), p, value_of),
+        };
+        let nc = NQ * seeded.len();
+        for lvl in 0..3 {
+            let (to, from) = (lvl * n_own + NQ * seeded.start, lvl * nc);
+            dz[to..to + nc].copy_from_slice(&g[from..from + nc]);
+        }
+    }
+    dz
+}
+
+/// ∂y/∂(q, u, u̇ of the bodies `own[seeded]`), the other bodies held constant: q of the
+/// seeded bodies, then u, then u̇ (K ≥ 18 per seeded body).
 fn grad_k<const K: usize>(
     sys: &System,
     e: &Expr,
     abase: usize,
-    bodies: &[usize],
+    own: &[usize],
+    seeded: Range<usize>,
     p: Point,
     value_of: &dyn Fn(LoadFn, ElementRef) -> f64,
 ) -> Vec<f64> {
-    let nq = NQ * bodies.len();
+    let nc = NQ * seeded.len();
+    let first = NQ * seeded.start..NQ * seeded.end;
     let seed = |x: Vec<f64>, off: usize| -> Vec<Dual<f64, K>> {
-        x.iter().enumerate().map(|(i, &v)| Dual::var(v, off + i)).collect()
+        let var =
+            |i: usize, v: f64| if first.contains(&i) { Dual::var(v, off + i - first.start) } else { Dual::cst(v) };
+        x.iter().enumerate().map(|(i, &v)| var(i, v)).collect()
     };
-    let (ql, ul, al) =
-        (seed(gather(bodies, p.q), 0), seed(gather(bodies, p.u), nq), seed(gather(bodies, p.udot), 2 * nq));
-    let mut ctx = LocalCtx::new(sys, bodies, &ql, &ul, &al, Dual::cst(p.t), p.inputs);
+    let (ql, ul, al) = (seed(gather(own, p.q), 0), seed(gather(own, p.u), nc), seed(gather(own, p.udot), 2 * nc));
+    let mut ctx = LocalCtx::new(sys, own, &ql, &ul, &al, Dual::cst(p.t), p.inputs);
     let loads = |f: LoadFn, r: ElementRef| Dual::cst(value_of(f, r));
     ctx.loads = Some(&loads);
-    ctx.eval_expr(e, abase).d[..3 * nq].to_vec()
+    ctx.eval_expr(e, abase).d[..3 * nc].to_vec()
 }

@@ -252,3 +252,79 @@ fn static_analysis_finds_the_equilibrium_and_its_analytic_frequencies() {
     sim.advance(1.0).unwrap();
     assert!((sim.outputs().unwrap()[0] - a0).abs() < 1e-9);
 }
+
+/// A planar 5-link pendulum, released horizontal, a torque input on the first hinge;
+/// its outputs each measure all five bodies (more than one element may touch).
+fn five_link_chain() -> String {
+    let (n, l) = (5, 0.5);
+    let mut s = String::from(
+        r#"<multibody name="chain5" version="1">
+  <gravity value="0 0 -9.81"/>
+  <ground><marker name="O" position="0 0 0" z_axis="0 1 0"/></ground>
+"#,
+    );
+    for i in 0..n {
+        let x = l / 2.0 + i as f64 * l;
+        s += &format!(
+            r#"  <body name="b{i}" mass="{m}" inertia="0.001 {j} {j}" position="{x} 0 0">
+    <marker name="P" position="{h} 0 0" z_axis="0 1 0"/>
+    <marker name="A" position="{k} 0 0" z_axis="0 1 0"/>
+  </body>
+"#,
+            m = 1.0 + 0.1 * i as f64,
+            j = l * l / 12.0,
+            h = -l / 2.0,
+            k = l / 2.0
+        );
+        let j = if i == 0 { "ground.O".to_string() } else { format!("b{}.A", i - 1) };
+        s += &format!("  <joint name=\"h{i}\" type=\"revolute\" i=\"b{i}.P\" j=\"{j}\"/>\n");
+    }
+    let sum = |f: &dyn Fn(usize) -> String| (0..n).map(f).collect::<Vec<_>>().join(" + ");
+    s += r#"  <input name="T" start="0.4"/>
+  <sforce name="motor" type="rotational" i="b0.P" j="ground.O" function="T"/>
+"#;
+    s += &format!(
+        "  <output name=\"energy\" function=\"{}\"/>\n",
+        sum(&|i| format!("0.5*vm(b{i}.cm)^2 + 9.81*dz(b{i}.cm)"))
+    );
+    s += &format!("  <output name=\"acc\" function=\"{} + 0.1*T\"/>\n", sum(&|i| format!("accz(b{i}.cm)")));
+    s + "</multibody>\n"
+}
+
+#[test]
+fn outputs_that_measure_more_bodies_than_an_element_may_match_central_differences() {
+    // An output is not an element: it may measure every body of the model. Its gradient is
+    // seeded four bodies at a time; C and D against central differences of the state-space
+    // map, h = 1e-6 and tolerance 1e-6 relative to max(1, |entry|) as for the spatial arm.
+    let m = load_str(&five_link_chain(), "chain5.xml").unwrap();
+    let mut sim = Simulator::new(&m, SimOptions { tol: 1e-10, max_step: None, ..Default::default() }, 0.0).unwrap();
+    let sel = select_states(sim.system(), sim.q(), 0.0, &sim.inputs()).unwrap();
+    assert_eq!(sel.states.len(), 5);
+    sim.advance(0.2).unwrap();
+    let lin = linearize(&mut sim, &sel, 2).unwrap();
+    let (sys, q0, t, v0) = (sim.system().clone(), sim.q().to_vec(), sim.time(), sim.inputs());
+    let (x0, h) = (lin.x.clone(), 1e-6);
+    let check = |name: &str, got: f64, want: f64| {
+        assert!((got - want).abs() < 1e-6 * want.abs().max(1.0), "{name}: {got} vs {want}");
+    };
+    for j in 0..x0.len() {
+        let (mut xp, mut xm) = (x0.clone(), x0.clone());
+        xp[j] += h;
+        xm[j] -= h;
+        let (_, yp) = state_space(&sys, &sel, &q0, t, &xp, &v0);
+        let (_, ym) = state_space(&sys, &sel, &q0, t, &xm, &v0);
+        for o in 0..2 {
+            check(&format!("C[{o},{j}]"), lin.c[(o, j)], (yp[o] - ym[o]) / (2.0 * h));
+        }
+    }
+    let (mut vp, mut vm) = (v0.clone(), v0.clone());
+    vp[0] += h;
+    vm[0] -= h;
+    let ((_, yp), (_, ym)) = (state_space(&sys, &sel, &q0, t, &x0, &vp), state_space(&sys, &sel, &q0, t, &x0, &vm));
+    for o in 0..2 {
+        check(&format!("D[{o},0]"), lin.d[(o, 0)], (yp[o] - ym[o]) / (2.0 * h));
+    }
+    // Every body counts: the energy's row is not zero in any velocity state.
+    assert!((5..10).all(|j| lin.c[(0, j)].abs() > 1e-3), "C row of energy: {:?}", lin.c.row(0));
+    assert!(lin.d[(1, 0)].abs() > 0.1, "D of acc: {}", lin.d[(1, 0)]);
+}

@@ -431,3 +431,9 @@ case!(
     "69_entity_in_expression.xml",
     "69_entity_in_expression.xml:3:42: output 'y': bad expression in 'function': unknown name 'q'"
 );
+
+case!(
+    m71_state_touches_five_bodies,
+    "71_state_touches_five_bodies.xml",
+    "71_state_touches_five_bodies.xml:8:21: state 's': touches 5 bodies (a, b, c, d, e); an element may touch at most 4"
+);

@@ -87,6 +87,7 @@ impl<'a> Loader<'a> {
                 let at = el.get("name").map_or(c.pos, |a| a.pos);
                 return Err(el.err_at(at, format!("name '{name}' is already used by {kind} at line {line}")));
             }
+            check_body_count(&el, &self.scope, &[], &[("function", &function)], false)?;
             if c.tag == "state" {
                 check_deps(&el, "function", &function, Allowed::Positions)?;
                 self.model.lin_states.push(LinState { name, function, pos });
