@@ -9,6 +9,17 @@ use crate::model::expr;
 use crate::model::*;
 
 impl<'a> Loader<'a> {
+    /// The `function` of a `<variable>` or `<differential>`: it may read what a force
+    /// reads, touches at most the element body count, and its loads go to `load_readers`.
+    fn user_function(&self, x: &'a XElem, load_readers: &mut Vec<LoadReader<'a>>) -> Result<expr::Expr, ModelError> {
+        let el = self.el(x);
+        let function = el.expr_req("function")?;
+        check_deps(&el, "function", &function, Allowed::Force)?;
+        check_body_count(&el, &self.scope, &[], &[("function", &function)], true)?;
+        load_readers.push((x, "function", expr::deps(&function).loads));
+        Ok(function)
+    }
+
     /// `<variable>`: a user variable V = `function`; the loads it reads go to
     /// `load_readers`.
     pub(super) fn build_variable(
@@ -16,11 +27,7 @@ impl<'a> Loader<'a> {
         x: &'a XElem,
         load_readers: &mut Vec<LoadReader<'a>>,
     ) -> Result<(), ModelError> {
-        let el = self.el(x);
-        let function = el.expr_req("function")?;
-        check_deps(&el, "function", &function, Allowed::Force)?;
-        check_body_count(&el, &self.scope, &[], &[("function", &function)], true)?;
-        load_readers.push((x, "function", expr::deps(&function).loads));
+        let function = self.user_function(x, load_readers)?;
         self.model.variables.push(Variable { name: x.label().into(), function, pos: x.pos });
         Ok(())
     }
@@ -32,11 +39,8 @@ impl<'a> Loader<'a> {
         x: &'a XElem,
         load_readers: &mut Vec<LoadReader<'a>>,
     ) -> Result<(), ModelError> {
+        let function = self.user_function(x, load_readers)?;
         let el = self.el(x);
-        let function = el.expr_req("function")?;
-        check_deps(&el, "function", &function, Allowed::Force)?;
-        check_body_count(&el, &self.scope, &[], &[("function", &function)], true)?;
-        load_readers.push((x, "function", expr::deps(&function).loads));
         let implicit = el.keyword("implicit", &[("true", true), ("false", false)])?.unwrap_or(false);
         let me = self.model.differentials.len();
         if implicit && !expr::deps(&function).diff_dots.contains(&me) {
