@@ -29,6 +29,7 @@ pub use simulate::{SimulateArgs, communication_points};
 #[derive(Debug, Parser)]
 #[command(name = "mbfmu", version, about)]
 pub struct Cli {
+    /// The subcommand and its arguments.
     #[command(subcommand)]
     pub command: Command,
 }

@@ -54,9 +54,13 @@ pub struct SimulateArgs {
 /// Start, end, step and tolerance of one simulation run.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RunSettings {
+    /// Start time (s): the model's `<experiment start>`, else 0 (no command-line option).
     pub start: f64,
+    /// End time (s), finite and not before `start`.
     pub end: f64,
+    /// Communication step (s), positive: the output interval.
     pub step: f64,
+    /// Integrator tolerance (relative and absolute), positive.
     pub tol: f64,
 }
 

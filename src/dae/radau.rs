@@ -28,12 +28,21 @@ pub trait DaeProblem {
 /// Integrator statistics.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Stats {
+    /// Step attempts, accepted and rejected.
     pub steps: usize,
+    /// Accepted steps.
     pub accepted: usize,
+    /// Rejected attempts: failed error test, Newton failure or slow convergence, singular
+    /// iteration matrix.
     pub rejected: usize,
+    /// Simplified-Newton iterations, over all attempts.
     pub newton_iterations: usize,
+    /// Evaluations of J = ∂f/∂y.
     pub jacobians: usize,
+    /// Numeric factorizations of the iteration matrices (one counts both the real n×n
+    /// and the 2n×2n complex-pair block).
     pub factorizations: usize,
+    /// Evaluations of f(t, y), the stages and the error estimate's included.
     pub rhs_evaluations: usize,
     /// Symbolic sparse-LU analyses: one per matrix while the sparsity pattern is unchanged.
     pub symbolic_analyses: usize,
@@ -45,10 +54,14 @@ pub struct Radau {
     /// User tolerance and the internal (RADAU5-calibrated) ones.
     rtol: f64,
     atol: f64,
+    /// Current time: of the last accepted step, or exactly `t_end` after a successful
+    /// [`Radau::advance`].
     pub t: f64,
+    /// Solution at `t`.
     pub y: Vec<f64>,
     /// Next step size to try.
     pub h: f64,
+    /// Upper bound on the step size (s); infinite unless set.
     pub max_step: f64,
     /// Most step attempts (accepted and rejected) one [`Radau::advance`] may make.
     pub max_steps: usize,
@@ -69,6 +82,7 @@ pub struct Radau {
     first: bool,
     last_rejected: bool,
     faccon: f64,
+    /// Counts since [`Radau::new`].
     pub stats: Stats,
 }
 

@@ -10,11 +10,14 @@ pub struct Tableau {
     pub c: [f64; 3],
     /// Real eigenvalue of A⁻¹.
     pub gamma: f64,
-    /// Complex eigenvalue pair α ± iβ of A⁻¹.
+    /// Real part α of the complex eigenvalue pair α ± iβ of A⁻¹.
     pub alpha: f64,
+    /// Imaginary part β (> 0) of that pair.
     pub beta: f64,
-    /// Z = (T ⊗ I) W and W = (T⁻¹ ⊗ I) Z.
+    /// T, row-major, columns: the real eigenvector of A⁻¹, then the real and imaginary
+    /// parts of the one for α + iβ; the stage increments are Z = (T ⊗ I) W.
     pub t: [[f64; 3]; 3],
+    /// T⁻¹, row-major: W = (T⁻¹ ⊗ I) Z.
     pub ti: [[f64; 3]; 3],
     /// Embedded error estimate weights (err = (γ/h M − J)⁻¹ (f0 + M Σ dd_i Z_i / h)).
     pub dd: [f64; 3],

@@ -11,7 +11,9 @@ use faer::{Conj, Mat, MatMut, Par};
 /// A matrix under construction, as (row, col, value) entries; duplicates are summed.
 #[derive(Clone, Debug, Default)]
 pub struct Triplets {
+    /// (row, column) of each entry, in push order; a position may repeat (values summed).
     pub idx: Vec<Pair<usize, usize>>,
+    /// Value of each entry, parallel to `idx`.
     pub vals: Vec<f64>,
 }
 

@@ -14,8 +14,12 @@ const MAGIC: &[u8; 8] = b"MBFMUF02";
 pub struct FmuState {
     /// GUID of the model: a state restores only into an instance of the same FMU.
     pub guid: String,
+    /// The instance's state-machine state when the FMU state was taken.
     pub state: State,
+    /// The host's choices then: parameter and input values, input slopes, experiment,
+    /// `solver.maxSteps`.
     pub config: Config,
+    /// fmi2LastSuccessfulTime then (s).
     pub last_time: f64,
     /// The engine (None before initialization).
     pub sim: Option<SimState>,

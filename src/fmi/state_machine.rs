@@ -5,15 +5,25 @@
 /// A state of a Co-Simulation instance; each is one bit so a set of states is a mask.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum State {
+    /// instantiated: after fmi2Instantiate or fmi2Reset, before
+    /// fmi2EnterInitializationMode.
     Instantiated = 1,
+    /// initializationMode: between fmi2EnterInitializationMode and
+    /// fmi2ExitInitializationMode.
     InitializationMode = 2,
     /// slaveInitialized: after fmi2ExitInitializationMode and every successful fmi2DoStep.
     StepComplete = 4,
     /// fmi2DoStep returned fmi2Discard.
     StepFailed = 8,
+    /// stepCanceled: never entered by this FMU (fmi2DoStep is synchronous, fmi2CancelStep
+    /// is refused).
     StepCanceled = 16,
+    /// terminated: after fmi2Terminate.
     Terminated = 32,
+    /// error: after a panic in a function that cannot have left the engine half-updated.
     Error = 64,
+    /// fatal: after a panic in a function that may have left the engine half-updated;
+    /// only fmi2FreeInstance is allowed.
     Fatal = 128,
 }
 
@@ -52,41 +62,73 @@ const READABLE: u32 = INIT | DONE | FAIL | CANC | TERM | ERR;
 /// An FMI function that takes an instance.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Func {
+    /// `fmi2SetDebugLogging`.
     SetDebugLogging,
+    /// `fmi2FreeInstance`.
     FreeInstance,
+    /// `fmi2SetupExperiment`.
     SetupExperiment,
+    /// `fmi2EnterInitializationMode`.
     EnterInitializationMode,
+    /// `fmi2ExitInitializationMode`.
     ExitInitializationMode,
+    /// `fmi2Terminate`.
     Terminate,
+    /// `fmi2Reset`.
     Reset,
+    /// `fmi2GetReal`.
     GetReal,
+    /// `fmi2GetInteger`.
     GetInteger,
+    /// `fmi2GetBoolean`.
     GetBoolean,
+    /// `fmi2GetString`.
     GetString,
+    /// `fmi2SetReal`.
     SetReal,
+    /// `fmi2SetInteger`.
     SetInteger,
+    /// `fmi2SetBoolean`.
     SetBoolean,
+    /// `fmi2SetString`.
     SetString,
+    /// `fmi2GetFMUstate`.
     GetFmuState,
+    /// `fmi2SetFMUstate`.
     SetFmuState,
+    /// `fmi2FreeFMUstate`.
     FreeFmuState,
+    /// `fmi2SerializedFMUstateSize`.
     SerializedFmuStateSize,
+    /// `fmi2SerializeFMUstate`.
     SerializeFmuState,
+    /// `fmi2DeSerializeFMUstate`.
     DeSerializeFmuState,
+    /// `fmi2GetDirectionalDerivative`.
     GetDirectionalDerivative,
+    /// `fmi2SetRealInputDerivatives`.
     SetRealInputDerivatives,
+    /// `fmi2GetRealOutputDerivatives`.
     GetRealOutputDerivatives,
+    /// `fmi2DoStep`.
     DoStep,
+    /// `fmi2CancelStep`.
     CancelStep,
+    /// `fmi2GetStatus`.
     GetStatus,
+    /// `fmi2GetRealStatus`.
     GetRealStatus,
+    /// `fmi2GetIntegerStatus`.
     GetIntegerStatus,
+    /// `fmi2GetBooleanStatus`.
     GetBooleanStatus,
+    /// `fmi2GetStringStatus`.
     GetStringStatus,
 }
 
 /// One row of the table.
 pub struct Rule {
+    /// The function of this row; rows are in `Func` order, so `RULES[f as usize].func == f`.
     pub func: Func,
     /// The C name, used in every message.
     pub name: &'static str,

@@ -32,11 +32,19 @@ pub const FALSE: Boolean = 0;
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Status {
+    /// fmi2OK: all well.
     Ok = 0,
+    /// fmi2Warning: something is not quite right, but the computation can continue.
     Warning = 1,
+    /// fmi2Discard: the call was carried out only partly; for fmi2DoStep, the step stopped
+    /// at fmi2LastSuccessfulTime.
     Discard = 2,
+    /// fmi2Error: the call failed.
     Error = 3,
+    /// fmi2Fatal: the instance is unusable; only fmi2FreeInstance may follow.
     Fatal = 4,
+    /// fmi2Pending: an asynchronous fmi2DoStep is still running (never returned here:
+    /// fmi2DoStep is synchronous).
     Pending = 5,
 }
 
@@ -69,9 +77,18 @@ pub type StepFinishedFn = unsafe extern "C" fn(ComponentEnvironment, c_int);
 #[repr(C)]
 #[derive(Clone, Copy, Debug)]
 pub struct CallbackFunctions {
+    /// `logger` (fmi2CallbackLogger): receives every message, with `componentEnvironment`;
+    /// NULL: messages are dropped.
     pub logger: Option<LoggerFn>,
+    /// `allocateMemory` (fmi2CallbackAllocateMemory): not used, the FMU allocates with
+    /// Rust's allocator.
     pub allocate_memory: Option<AllocateMemoryFn>,
+    /// `freeMemory` (fmi2CallbackFreeMemory): not used either.
     pub free_memory: Option<FreeMemoryFn>,
+    /// `stepFinished` (fmi2StepFinished): for asynchronous fmi2DoStep; not used (fmi2DoStep
+    /// is synchronous).
     pub step_finished: Option<StepFinishedFn>,
+    /// `componentEnvironment` (fmi2ComponentEnvironment): the host's pointer, passed back
+    /// as the logger's first argument.
     pub component_environment: ComponentEnvironment,
 }

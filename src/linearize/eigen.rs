@@ -11,6 +11,7 @@ pub struct EigenRow {
     pub frequency: f64,
     /// Damping ratio −Re λ / |λ| (1 for a real negative root; NaN for λ = 0).
     pub damping: f64,
+    /// Real part Re λ (1/s); negative for a decaying mode.
     pub re: f64,
     /// Imaginary part (≥ 0: one row per conjugate pair).
     pub im: f64,

@@ -59,12 +59,18 @@ impl PositionFn for ConstraintEl {
 /// g, ġ, g̈ of one component with gradients over z = (local q, local u, local u̇, t).
 #[derive(Clone, Debug)]
 pub struct Jet {
+    /// g(q, t) (w(q, u, t) for a velocity-level function).
     pub g: f64,
+    /// ġ = dg/dt along the motion (q̇ = H u).
     pub g1: f64,
+    /// g̈ = d²g/dt² along the motion (for a velocity-level function, ẅ as if ü = 0).
     pub g2: f64,
-    /// Gradients (length 18·nb + 1).
+    /// ∂g/∂z, length 18·nb + 1 for nb bodies: q of every body (6 each, in
+    /// [`PositionFn::bodies`] order), then u, then u̇, then t.
     pub dg: Vec<f64>,
+    /// ∂ġ/∂z, same layout as `dg`.
     pub dg1: Vec<f64>,
+    /// ∂g̈/∂z, same layout as `dg`.
     pub dg2: Vec<f64>,
 }
 

@@ -16,22 +16,37 @@ use crate::model::expr::{ElementRef, Expr, LoadFn, deps};
 use std::ops::Range;
 
 /// Gradient of one output: its bodies, ∂y/∂(q, u, u̇) local (18·nb: q of every body,
-/// then u, then u̇), ∂y/∂λ as (global row, value) pairs, and ∂y/∂v per input.
+/// then u, then u̇), ∂y/∂λ as (global row, value) pairs, and ∂y/∂ext per external value.
 pub struct OutputGradient {
+    /// Bodies of the output and of every load it reads (global indices, ascending): the
+    /// local order of `dz`.
     pub bodies: Vec<usize>,
+    /// ∂y/∂(local q, u, u̇), loads chained in: q of each body of `bodies` (6 each), then u,
+    /// then u̇; all NaN when it reads a load that has no value.
     pub dz: Vec<f64>,
+    /// ∂y/∂λ through the loads it reads, as (global multiplier row, value); a row may
+    /// appear more than once (the values add up).
     pub dlam: Vec<(usize, f64)>,
+    /// ∂y/∂ext, one entry per external value of [`Point::inputs`] (inputs v, then Z, then
+    /// loads L).
     pub dv: Vec<f64>,
 }
 
-/// The operating point: global q, u, u̇, λ, time and input values.
+/// The operating point: global q, u, u̇, λ, time and external values.
 #[derive(Clone, Copy)]
 pub struct Point<'a> {
+    /// Coordinates q, 6 per body: [r; ψ θ φ].
     pub q: &'a [f64],
+    /// Velocities u, 6 per body: [v; ω'], ω' in body axes.
     pub u: &'a [f64],
+    /// Accelerations u̇, 6 per body.
     pub udot: &'a [f64],
+    /// Multipliers: λ of the holonomic rows, then ν of the non-holonomic ones.
     pub lam: &'a [f64],
+    /// Time (s).
     pub t: f64,
+    /// Not only the inputs: every external value ext = [inputs v; Z; L], laid out by
+    /// [`ExtLayout`](crate::mechanics::external::ExtLayout).
     pub inputs: &'a [f64],
 }
 

@@ -14,7 +14,9 @@ pub const BASE_NAMES: [&str; 8] = ["kg", "m", "s", "A", "K", "mol", "cd", "rad"]
 /// A parsed unit: exponents of [`BASE_NAMES`] and the factor to SI.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Unit {
+    /// Exponent of each base unit, in [`BASE_NAMES`] order (kg m s A K mol cd rad).
     pub exps: [i32; 8],
+    /// SI value of one of this unit (1e-3 for `mm` or `g`, π/180 for `deg`).
     pub factor: f64,
 }
 

@@ -99,31 +99,47 @@ pub enum LoadFn {
 /// What a load function names.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ElementRef {
+    /// Index into `Model::joints`.
     Joint(usize),
+    /// Index into `Model::motions`.
     Motion(usize),
+    /// Index into `Model::constraints` (a user constraint has no load: the reader rejects it).
     Constraint(usize),
+    /// Index into `Model::spring_dampers`.
     SpringDamper(usize),
+    /// Index into `Model::sforces`.
     Sforce(usize),
+    /// Index into `Model::gforces`.
     Gforce(usize),
+    /// Index into `Model::bushings`.
     Bushing(usize),
 }
 
 /// An expression node.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Expr {
+    /// A number literal (`pi` too).
     Num(f64),
+    /// `time` (s).
     Time,
+    /// Parameter, index into `Model::parameters`.
     Param(usize),
+    /// Input, index into `Model::inputs`.
     Input(usize),
+    /// User variable, index into `Model::variables`.
     Variable(usize),
     /// `dif(name)` or a bare differential name.
     Diff(usize),
     /// `dif1(name)`.
     DiffDot(usize),
+    /// Unary minus.
     Neg(Box<Expr>),
+    /// `lhs op rhs`.
     Bin(BinOp, Box<Expr>, Box<Expr>),
+    /// A math function and its arguments.
     Math(MathFn, Vec<Expr>),
     /// Kinematic measure with markers i, j, k (j, k `None` = ground).
     Kin(KinFn, MarkerId, Option<MarkerId>, Option<MarkerId>),
+    /// A load component of an element: `fx(name)` ...
     Load(LoadFn, ElementRef),
 }

@@ -8,14 +8,20 @@ use crate::geom::{M3, V3};
 /// Pose of a marker in ground: origin position and rotation (columns = marker axes).
 #[derive(Clone, Copy, Debug)]
 pub struct Pose<T: Real> {
+    /// Origin position in ground (m).
     pub p: V3<T>,
+    /// Rotation from marker to ground axes: its columns are the marker axes in ground.
     pub r: M3<T>,
 }
 
 /// Velocity of a marker's origin and its angular velocity, ground components.
 #[derive(Clone, Copy, Debug)]
 pub struct Twist<T: Real> {
+    /// Velocity of the origin (m/s), ground components; the acceleration (m/s²) in what
+    /// [`ExprEnv::accel`] returns.
     pub v: V3<T>,
+    /// Angular velocity (rad/s), ground components; the angular acceleration (rad/s²) in
+    /// what [`ExprEnv::accel`] returns.
     pub w: V3<T>,
 }
 

@@ -20,7 +20,9 @@ pub(super) enum Tok {
 /// A token and the character offset where it starts.
 #[derive(Clone, Debug, PartialEq)]
 pub(super) struct Token {
+    /// The token's kind and value.
     pub tok: Tok,
+    /// 0-based character offset of its first character in the expression text.
     pub offset: usize,
 }
 

@@ -5,9 +5,13 @@ use super::ast::{ElementRef, MarkerId};
 /// What a bare identifier in an expression names.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum NameRef {
+    /// Parameter, index into `Model::parameters`.
     Param(usize),
+    /// Input, index into `Model::inputs`.
     Input(usize),
+    /// User variable V, index into `Model::variables`.
     Variable(usize),
+    /// Differential state X, index into `Model::differentials`.
     Diff(usize),
 }
 
@@ -39,5 +43,6 @@ pub trait Scope {
 pub struct ExprError {
     /// 0-based character offset into the expression text.
     pub offset: usize,
+    /// What is wrong.
     pub msg: String,
 }

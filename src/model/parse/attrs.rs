@@ -9,8 +9,11 @@ use crate::model::{ModelError, Num, NumVec, SrcPos};
 
 /// One element being read, with what its constant attributes may use.
 pub(crate) struct El<'a> {
+    /// The XML element being read.
     pub x: &'a XElem,
+    /// The model text, for positions and messages.
     pub src: &'a Source<'a>,
+    /// Names its expressions may use.
     pub scope: &'a ModelScope,
     /// Evaluated parameter values (empty while parameters themselves are read).
     pub params: &'a [f64],

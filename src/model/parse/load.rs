@@ -10,21 +10,36 @@ use std::collections::HashMap;
 
 /// State of one model read.
 pub(crate) struct Loader<'a> {
+    /// The model text and its file label: positions and error messages.
     pub src: &'a Source<'a>,
+    /// The `<multibody>` root element.
     pub root: &'a XElem,
+    /// Every name the first pass declared; expressions resolve names against it.
     pub scope: ModelScope,
+    /// Evaluated parameter values in file order (empty until `evaluate_parameters`).
     pub params: Vec<f64>,
+    /// Body names, for duplicate detection.
     pub ns_bodies: Namespace,
+    /// Full marker names (`owner.marker`), for duplicate detection.
     pub ns_markers: Namespace,
+    /// Joint names to joint index; motions look their joint up here.
     pub ns_joints: Namespace,
+    /// Motion names, for duplicate detection.
     pub ns_motions: Namespace,
+    /// User constraint names, for duplicate detection.
     pub ns_constraints: Namespace,
+    /// Names of spring-dampers, sforces, gforces and bushings: one namespace, numbered
+    /// across the four kinds.
     pub ns_forces: Namespace,
+    /// Output names (a linearization state may not reuse one).
     pub ns_outputs: Namespace,
+    /// Linearization `<state>` and `<velocity>` names: one namespace.
     pub ns_lin: Namespace,
+    /// Rolling wheel, knife edge and velocity constraint names: one namespace.
     pub ns_nonholonomic: Namespace,
     /// Once-only elements already seen, with their line.
     pub singletons: HashMap<String, usize>,
+    /// The model being filled in; returned once every pass has succeeded.
     pub model: Model,
 }
 

@@ -11,6 +11,7 @@ use std::fmt;
 /// difference, the degrees of freedom.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Summary {
+    /// Number of bodies (ground not counted).
     pub bodies: usize,
     /// 6 · bodies.
     pub coordinates: usize,

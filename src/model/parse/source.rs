@@ -4,12 +4,15 @@ use crate::model::{ModelError, SrcPos};
 
 /// The text being read and where it came from.
 pub(crate) struct Source<'t> {
+    /// Label of the text in messages (usually its path).
     pub file: String,
+    /// The whole model text, as read (a byte-order mark included).
     pub text: &'t str,
     line_starts: Vec<usize>,
 }
 
 impl<'t> Source<'t> {
+    /// Index the line starts of `text`, labelled `file` in messages.
     pub fn new(text: &'t str, file: &str) -> Self {
         let mut line_starts = vec![0];
         line_starts.extend(text.match_indices('\n').map(|(i, _)| i + 1));

@@ -8,7 +8,10 @@ use quick_xml::events::{BytesStart, Event};
 /// One attribute: name, unescaped value, and positions.
 #[derive(Debug)]
 pub(crate) struct XAttr {
+    /// Attribute name as written (no namespace handling).
     pub name: String,
+    /// Value with entities replaced and white space normalized as XML requires (a line end
+    /// or tab becomes a space).
     pub value: String,
     /// Position of the attribute name.
     pub pos: SrcPos,
@@ -19,10 +22,13 @@ pub(crate) struct XAttr {
 /// One element with its attributes and child elements (text and comments dropped).
 #[derive(Debug)]
 pub(crate) struct XElem {
+    /// Element name as written (`body`, `joint`, ...).
     pub tag: String,
     /// Position of the element's `<`.
     pub pos: SrcPos,
+    /// Attributes in written order.
     pub attrs: Vec<XAttr>,
+    /// Child elements in written order.
     pub children: Vec<XElem>,
 }
 
