@@ -228,3 +228,54 @@ fn no_input_makes_the_reader_panic() {
     let deep = "<multibody name=\"m\" version=\"1\">".to_string() + &"<ground>".repeat(100_000);
     assert!(load_str(&deep, "deep.xml").is_err());
 }
+
+/// A model whose every kind of numeric attribute uses parameter `p`; its value is the
+/// placeholder P.
+const EVERY_ATTRIBUTE: &str = r#"<multibody name="every" version="1">
+  <parameter name="p" value="P" unit="m"/>
+  <gravity value="0, 0, -9*p"/>
+  <input name="u" start="p"/>
+  <ground><marker name="O" position="p 0 0" euler313="p 0 0"/></ground>
+  <body name="a" mass="2*p" inertia="p, 2*p, 3*p" position="0 0 p" euler313="0 p 0"
+        velocity="p 0 0" angular_velocity="0 0 p">
+    <marker name="m" position="0 p 0" z_axis="p 0 1" x_axis="0 1 0"/>
+    <marker name="w" position="0 0 -p"/>
+  </body>
+  <body name="b" mass="1" inertia="1 1 1" position="1 0 0">
+    <marker name="m" position="0 0 0"/>
+  </body>
+  <joint name="j" type="cylindrical" i="a.m" j="ground.O" ic_angle="p/10" ic_angular_speed="p"
+         ic_displacement="p/5" ic_speed="2*p"/>
+  <spring_damper name="k" type="translational" i="a.m" j="b.m" stiffness="10*p" damping="p"
+                 length="p" preload="3*p"/>
+  <bushing name="bu" i="b.m" j="ground.O" stiffness="p, 2*p, 3*p, 4*p, 5*p, 6*p"
+           damping="p, p, p, 2*p, 2*p, 2*p"/>
+  <rolling_wheel name="rw" marker="a.w" radius="p/2"/>
+  <differential name="x" start="4*p" function="-x"/>
+</multibody>"#;
+
+#[test]
+fn with_params_equals_loading_the_model_with_those_values() {
+    // The independent reference for re-evaluation: the same text loaded with the new value
+    // written in. Every attribute must agree exactly (both evaluate the same expressions
+    // with the same numbers); only the parameter's own expression differs.
+    let load = |p: f64| load_str(&EVERY_ATTRIBUTE.replace("\"P\"", &format!("\"{p:?}\"")), "every.xml").unwrap();
+    let (m, direct) = (load(1.25), load(1.75));
+    let mut changed = m.with_params(&[1.75]).unwrap_or_else(|e| panic!("{e}"));
+    assert_ne!(m, direct);
+    changed.parameters = direct.parameters.clone();
+    assert_eq!(changed, direct);
+}
+
+#[test]
+fn with_params_refuses_a_wheel_radius_that_becomes_non_positive() {
+    let m = load_str(&EVERY_ATTRIBUTE.replace("\"P\"", "\"1\""), "every.xml").unwrap();
+    let e = m.with_params(&[-1.0]).err();
+    // The body mass 2p is checked first.
+    assert_eq!(e.as_deref(), Some("body 'a': mass must be positive (got -2)"));
+    let text = EVERY_ATTRIBUTE.replace("\"P\"", "\"1\"").replace("mass=\"2*p\"", "mass=\"2\"");
+    let text = text.replace("inertia=\"p, 2*p, 3*p\"", "inertia=\"1 2 3\"");
+    let m = load_str(&text, "every.xml").unwrap();
+    let e = m.with_params(&[-1.0]).err();
+    assert_eq!(e.as_deref(), Some("rolling_wheel 'rw': radius must be positive (got -0.5)"));
+}

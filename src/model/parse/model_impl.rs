@@ -102,6 +102,16 @@ impl Model {
         for s in &mut self.spring_dampers {
             v.extend([&mut s.stiffness, &mut s.damping, &mut s.length, &mut s.preload]);
         }
+        for b in &mut self.bushings {
+            v.extend(vec_nums(&mut b.stiffness));
+            v.extend(b.damping.iter_mut().flat_map(vec_nums));
+        }
+        for w in &mut self.rolling_wheels {
+            v.push(&mut w.radius);
+        }
+        for d in &mut self.differentials {
+            v.push(&mut d.start);
+        }
         for i in &mut self.inputs {
             v.push(&mut i.start);
         }
@@ -111,7 +121,7 @@ impl Model {
     /// A copy with new parameter values (`values[i]` overrides parameter `i`'s expression)
     /// and every constant attribute re-evaluated; errors when the count is wrong or a value
     /// becomes invalid (non-finite, non-positive mass, inertia not positive definite,
-    /// degenerate axes).
+    /// degenerate axes, non-positive wheel radius).
     pub fn with_params(&self, values: &[f64]) -> Result<Model, String> {
         if values.len() != self.parameters.len() {
             return Err(format!("expected {} parameter values, got {}", self.parameters.len(), values.len()));
@@ -139,6 +149,11 @@ impl Model {
         }
         for mk in &m.markers {
             try_rotation(&mk.orientation).map_err(|e| format!("marker '{}': {e}", mk.name))?;
+        }
+        for w in &m.rolling_wheels {
+            if w.radius.value <= 0.0 {
+                return Err(format!("rolling_wheel '{}': radius must be positive (got {})", w.name, w.radius.value));
+            }
         }
         Ok(m)
     }

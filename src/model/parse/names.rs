@@ -50,7 +50,8 @@ impl Namespace {
 /// Everything a name in the model can refer to; implements the expression [`Scope`].
 #[derive(Default)]
 pub(crate) struct ModelScope {
-    /// Bare names: parameters and inputs (one namespace, so an expression is unambiguous).
+    /// Bare names: parameters, inputs, variables and differentials (one namespace, so an
+    /// expression is unambiguous), with the line each was declared on.
     pub names: HashMap<String, (NameRef, usize)>,
     /// Full marker names (`body.m`, `ground.m`, `body.cm`) to index.
     pub markers: HashMap<String, MarkerId>,
