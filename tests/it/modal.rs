@@ -431,3 +431,81 @@ fn bad_generator_values_are_refused() {
     let s = spec(2, 2, None, Reduction::CraigBampton { interface: vec![3], fixed_modes: 1 });
     assert_eq!(beam(&s).unwrap_err(), "--craig-bampton 3: no such node (nodes are 0 to 2)");
 }
+
+// ---- the command line ---------------------------------------------------------------
+
+use crate::common::mbfmu;
+
+const BEAM_ARGS: &[&str] = &[
+    "modal",
+    "beam",
+    "--length",
+    "2",
+    "--elements",
+    "12",
+    "--modes",
+    "4",
+    "--area",
+    "4e-4",
+    "--iy",
+    "4e-8",
+    "--iz",
+    "1e-8",
+    "--j",
+    "3e-8",
+    "--young",
+    "2.1e11",
+    "--poisson",
+    "0.3",
+    "--density",
+    "7850",
+];
+
+#[test]
+fn the_command_writes_a_file_the_reader_accepts() {
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("modal-tests");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("beam-cli.json");
+    let _ = std::fs::remove_file(&path);
+    let mut args = BEAM_ARGS.to_vec();
+    let p = path.to_str().unwrap();
+    args.extend(["--damping", "0.01", "--craig-bampton", "0,12", "--fixed-modes", "10", "-o", p]);
+    let o = mbfmu(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let d = read(&path).unwrap();
+    assert_eq!((d.nodes.len(), d.modes.len()), (13, 4));
+    assert_eq!(d.damping, ModalDamping::Ratios(vec![0.01; 4]));
+    assert!(String::from_utf8_lossy(&o.stdout).starts_with("13 nodes, 4 modes ("));
+    // Without -o the file goes to stdout.
+    let shear: Vec<&str> = BEAM_ARGS
+        .iter()
+        .map(|&a| {
+            if a == "--poisson" {
+                "--shear"
+            } else if a == "0.3" {
+                "8e10"
+            } else {
+                a
+            }
+        })
+        .collect();
+    let o = mbfmu(&shear);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(parse(&String::from_utf8_lossy(&o.stdout), "stdout").unwrap().modes.len(), 4);
+}
+
+#[test]
+fn a_bad_argument_exits_2_with_a_message() {
+    let mut args = BEAM_ARGS.to_vec();
+    args[5] = "0"; // --elements 0
+    let o = mbfmu(&args);
+    assert_eq!(o.status.code(), Some(2));
+    assert_eq!(String::from_utf8_lossy(&o.stderr), "error: --elements 0: must be at least 1\n");
+    let args: Vec<&str> = BEAM_ARGS.iter().map(|&a| if a == "0.3" { "0.7" } else { a }).collect();
+    let o = mbfmu(&args);
+    assert_eq!(o.status.code(), Some(2));
+    assert_eq!(String::from_utf8_lossy(&o.stderr), "error: --poisson 0.7: must be in (-1, 0.5)\n");
+    let o = mbfmu(&BEAM_ARGS[..BEAM_ARGS.len() - 2]); // no --density
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--density"));
+}
