@@ -24,6 +24,10 @@ use super::eigen::generalized_eigen;
 /// eigensolver, eps × ‖M^{-1/2} K M^{-1/2}‖).
 pub const RIGID_TOL: f64 = 1e-6;
 
+/// The largest number of elements: the eigensolvers are dense, O((6N)³) time and
+/// O((6N)²) memory (500 elements: 3006 DOFs, a few seconds).
+pub const MAX_ELEMENTS: usize = 500;
+
 /// How the beam's modes are obtained.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Reduction {
@@ -144,8 +148,11 @@ fn check(spec: &BeamSpec) -> Result<(), String> {
     if let Some((name, v)) = positive.iter().find(|(_, v)| !(v.is_finite() && *v > 0.0)) {
         return Err(format!("{name} {v}: must be a finite number > 0"));
     }
-    if spec.elements == 0 || spec.elements > u32::MAX as usize - 1 {
-        return Err(format!("--elements {}: must be at least 1", spec.elements));
+    if !(1..=MAX_ELEMENTS).contains(&spec.elements) {
+        return Err(format!(
+            "--elements {}: must be from 1 to {MAX_ELEMENTS} (the eigensolver is dense)",
+            spec.elements
+        ));
     }
     if spec.modes == 0 {
         return Err("--modes 0: must be at least 1".into());
@@ -192,7 +199,7 @@ fn describe(spec: &BeamSpec) -> String {
     };
     let clamp = spec.clamp.map_or(String::new(), |c| format!(", node {c} clamped"));
     format!(
-        "mbfmu modal beam: L = {} m, {} Euler-Bernoulli elements, lumped mass; A = {}, Iy = {}, Iz = {}, J = {}, E = {}, G = {}, rho = {}; {how}{clamp}",
+        "mbfmu modal beam: L = {:?} m, {} Euler-Bernoulli elements, lumped mass; A = {:?}, Iy = {:?}, Iz = {:?}, J = {:?}, E = {:?}, G = {:?}, rho = {:?}; {how}{clamp}",
         spec.length, spec.elements, s.area, s.iy, s.iz, s.j, m.young, m.shear, m.density
     )
 }

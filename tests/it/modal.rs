@@ -426,6 +426,8 @@ fn bad_generator_values_are_refused() {
     let mut s = spec(10, 6, None, Reduction::FreeInterface);
     s.section.iz = -1.0;
     assert_eq!(beam(&s).unwrap_err(), "--iz -1: must be a finite number > 0");
+    let s = spec(501, 1, None, Reduction::FreeInterface);
+    assert_eq!(beam(&s).unwrap_err(), "--elements 501: must be from 1 to 500 (the eigensolver is dense)");
     let s = spec(2, 20, None, Reduction::FreeInterface);
     assert_eq!(beam(&s).unwrap_err(), "--modes 20: the model has only 12 flexible modes");
     let s = spec(2, 2, None, Reduction::CraigBampton { interface: vec![3], fixed_modes: 1 });
@@ -500,7 +502,10 @@ fn a_bad_argument_exits_2_with_a_message() {
     args[5] = "0"; // --elements 0
     let o = mbfmu(&args);
     assert_eq!(o.status.code(), Some(2));
-    assert_eq!(String::from_utf8_lossy(&o.stderr), "error: --elements 0: must be at least 1\n");
+    assert_eq!(
+        String::from_utf8_lossy(&o.stderr),
+        "error: --elements 0: must be from 1 to 500 (the eigensolver is dense)\n"
+    );
     let args: Vec<&str> = BEAM_ARGS.iter().map(|&a| if a == "0.3" { "0.7" } else { a }).collect();
     let o = mbfmu(&args);
     assert_eq!(o.status.code(), Some(2));
