@@ -25,7 +25,8 @@ use super::eigen::generalized_eigen;
 pub const RIGID_TOL: f64 = 1e-6;
 
 /// The largest number of elements: the eigensolvers are dense, O((6N)³) time and
-/// O((6N)²) memory (500 elements: 3006 DOFs, a few seconds).
+/// O((6N)²) memory (500 elements: 3006 DOFs, about 100 s on one core; 64 elements: well
+/// under a second).
 pub const MAX_ELEMENTS: usize = 500;
 
 /// How the beam's modes are obtained.
