@@ -1,4 +1,4 @@
-//! The `mbfmu` command line: `check`, `simulate`, `pack`, `run`. One file per command; `main.rs`
+//! The `mbfmu` command line: `check`, `simulate`, `pack`, `linearize`, `modal`, `run`. One file per command; `main.rs`
 //! only calls [`main`].
 //!
 //! Exit codes: 0 success; 2 bad input (model error `file:line:col: element 'name': what is
@@ -11,6 +11,7 @@ mod input_csv;
 mod install;
 mod linearize;
 mod matrices;
+mod modal;
 mod pack;
 mod run;
 mod simulate;
@@ -22,6 +23,7 @@ use clap::{Parser, Subcommand};
 
 pub use error::CliError;
 pub use linearize::LinearizeArgs;
+pub use modal::{BeamArgs, ModalArgs, ModalCommand};
 pub use pack::PackArgs;
 pub use simulate::{SimulateArgs, communication_points};
 
@@ -52,6 +54,9 @@ pub enum Command {
     /// Linearize a model at one or more times: chosen states, eigenvalue table, and A, B,
     /// C, D as json, npz or mat.
     Linearize(LinearizeArgs),
+    /// Generate a modal data file of a flexible body (see MODEL_FORMAT.md, "Modal data
+    /// files"): `mbfmu modal beam ...`.
+    Modal(ModalArgs),
     /// Install this mbfmu with the FMU library embedded as PREFIX/bin/mbfmu (default
     /// PREFIX: ~/.local), so that `mbfmu pack` works from anywhere.
     Install(install::InstallArgs),
@@ -110,6 +115,7 @@ pub fn execute(command: &Command) -> Result<(), CliError> {
         Command::Simulate(args) => simulate::simulate(args, &mut out),
         Command::Pack(args) => pack::run(args, &mut out),
         Command::Linearize(args) => linearize::run(args, &mut out, &mut std::io::stderr().lock()),
+        Command::Modal(args) => modal::run(args, &mut out),
         Command::Install(args) => install::run(args, &mut out),
         Command::Run => run::run(&mut out),
     }

@@ -29,6 +29,7 @@ mod linearize_loads;
 mod linearize_seed;
 mod malformed;
 mod memory_valgrind;
+mod modal;
 mod model_description;
 mod models_parse;
 mod nonholonomic;
