@@ -23,8 +23,7 @@ use crate::mechanics::constraint_jacobian::IndependentRows;
 
 /// The layout of Eq. 34 for `sel` on `sys`, if its states complete the independent
 /// constraints to the coordinates (s0 + mr = n, s1 + mn = s0).
-fn eq34_layout(sys: &System, sel: &Selection, rows: &IndependentRows) -> Result<Eq34, EngineError> {
-    let lay = Layout::of(sys);
+fn eq34_layout(sys: &System, lay: Layout, sel: &Selection, rows: &IndependentRows) -> Result<Eq34, EngineError> {
     let (n, mr, mn) = (sys.n(), rows.count, sys.mn);
     let (s0, s1) = (sel.states.len(), sel.velocities.len());
     let eq = Eq34 { n, m: sys.m, mr, mn, s0, s1, nx: lay.nx, nz: lay.nz() };
@@ -56,9 +55,10 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
     let (q, u) = (sim.q().to_vec(), sim.u().to_vec());
     let sys = sim.system();
     let rows = IndependentRows::of(sys);
-    let eq = eq34_layout(sys, sel, &rows)?;
+    let lay = Layout::of(sys);
+    let eq = eq34_layout(sys, lay, sel, &rows)?;
     check_partition(sys, sel, &q, t, &ext)?;
-    let p = OperatingPoint { sys, sel, eq, lay: Layout::of(sys), rows, q, u, udot, lam, t, ext };
+    let p = OperatingPoint { sys, sel, eq, lay, rows, q, u, udot, lam, t, ext };
     let Assembled { k, values } = assemble(&p);
     let rhs = RightHandSides::of(&p);
     let sens = Sensitivities::of(&p);
