@@ -23,6 +23,13 @@ type Reads<'a> = &'a dyn Fn(&[&Expr]) -> Vec<usize>;
 impl System {
     /// Build the system from a validated model.
     pub fn from_model(model: &Model) -> Result<System, String> {
+        if let Some(b) = model.bodies.iter().find(|b| b.flex.is_some()) {
+            return Err(format!(
+                "flexible body '{}' (line {}): the engine does not simulate flexible bodies yet \
+                 (the model and its modal data read; see MODEL_FORMAT.md)",
+                b.name, b.pos.line
+            ));
+        }
         let bodies = bodies_and_initial_coordinates(model);
         let markers = markers(model);
         let mut slots = AngleSlots::default();

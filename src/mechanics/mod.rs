@@ -35,6 +35,7 @@ pub mod constraint_jacobian;
 pub mod constraints;
 pub mod external;
 pub mod external_values;
+pub mod flexible;
 pub mod force_laws;
 pub mod forces;
 pub mod from_model;

@@ -18,6 +18,7 @@ pub mod craig_bampton;
 pub mod data;
 pub mod eigen;
 pub mod error;
+pub mod invariants;
 pub mod matrix_checks;
 pub mod read;
 pub mod write;

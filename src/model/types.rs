@@ -89,8 +89,23 @@ pub struct Body {
     pub velocity: Option<NumVec>,
     /// Initial angular velocity (rad/s), ground components; `None`: zero.
     pub angular_velocity: Option<NumVec>,
+    /// A `<flexible_body>`'s modal data (`None`: a rigid `<body>`). Its `position` is then
+    /// the body frame's origin (the frame of the modal data), not the centre of mass, and
+    /// `mass`, `inertia` are the undeformed body's (inertia about the centre of mass).
+    pub flex: Option<FlexSpec>,
     /// Where the element starts (its `<`).
     pub pos: SrcPos,
+}
+
+/// The modal data of a `<flexible_body>`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FlexSpec {
+    /// The `modal` attribute as written.
+    pub file: String,
+    /// The path read (relative paths are relative to the model file's directory).
+    pub path: String,
+    /// The validated modal data.
+    pub data: crate::modal::ModalData,
 }
 
 /// `<marker>` (also the implicit `cm` marker of each body). Full name `body.marker`.
@@ -105,6 +120,10 @@ pub struct Marker {
     pub position: NumVec,
     /// Axes relative to the owner's frame (identity for `cm`).
     pub orientation: Orientation,
+    /// On a flexible body: the index (into the modal data's nodes) of the node the marker
+    /// is attached to; it then follows the node's deflection and small rotation, and its
+    /// `position` is the node's.
+    pub node: Option<usize>,
     /// Where the `<marker>` starts (for a `cm` marker, where its `<body>` starts).
     pub pos: SrcPos,
 }

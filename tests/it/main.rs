@@ -20,6 +20,7 @@ mod cli_linearize;
 mod dependencies;
 mod elements;
 mod expr_derivatives;
+mod flexible;
 mod fmi_capi;
 mod fmi_layer;
 mod fmi_sequences;

@@ -39,6 +39,7 @@ impl<'a> Loader<'a> {
             "gravity" => self.build_gravity(x),
             "ground" => self.build_ground(x),
             "body" => self.build_body(x),
+            "flexible_body" => self.build_flexible_body(x),
             "joint" => self.build_joint(x),
             "constraint" => self.build_constraint(x),
             "spring_damper" => self.build_spring_damper(x),
@@ -123,6 +124,7 @@ impl<'a> Loader<'a> {
             orientation: read_orientation(&el)?,
             velocity: el.num_vec("velocity", &[3])?,
             angular_velocity: el.num_vec("angular_velocity", &[3])?,
+            flex: None,
             pos: x.pos,
         };
         let idx = self.model.bodies.len();
@@ -133,6 +135,7 @@ impl<'a> Loader<'a> {
             body: Some(idx),
             position: NumVec { items: vec![constant(0.0), constant(0.0), constant(0.0)] },
             orientation: Orientation::Identity,
+            node: None,
             pos: x.pos,
         });
         for m in &x.children {
@@ -145,11 +148,15 @@ impl<'a> Loader<'a> {
     /// A `<marker>` of `owner` (a body's name, or "ground"), on `body`.
     fn marker(&self, x: &'a XElem, owner: &str, body: Option<usize>) -> Result<Marker, ModelError> {
         let el = self.el(x);
+        if let Some(a) = el.get("node") {
+            return Err(el.err_at(a.pos, format!("'node' is for markers of a <flexible_body>; '{owner}' is rigid")));
+        }
         Ok(Marker {
             name: format!("{owner}.{}", x.label()),
             body,
             position: el.vec3_req("position")?,
             orientation: read_orientation(&el)?,
+            node: None,
             pos: x.pos,
         })
     }

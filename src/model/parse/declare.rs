@@ -22,7 +22,12 @@ pub(crate) fn schema(tag: &str) -> Option<(&'static [&'static str], &'static [&'
             &["name", "mass", "inertia", "position", "euler313", "z_axis", "x_axis", "velocity", "angular_velocity"],
             &["name", "mass", "inertia", "position"],
         ),
-        "marker" => (&["name", "position", "euler313", "z_axis", "x_axis"], &["name", "position"]),
+        "flexible_body" => (
+            &["name", "modal", "position", "euler313", "z_axis", "x_axis", "velocity", "angular_velocity"],
+            &["name", "modal", "position"],
+        ),
+        // `position` is required unless `node` is given (checked when built).
+        "marker" => (&["name", "position", "node", "euler313", "z_axis", "x_axis"], &["name"]),
         "joint" => (
             &["name", "type", "i", "j", "ic_angle", "ic_angular_speed", "ic_displacement", "ic_speed"],
             &["name", "type", "i", "j"],
@@ -52,7 +57,7 @@ pub(crate) fn schema(tag: &str) -> Option<(&'static [&'static str], &'static [&'
 /// Which child elements an element may hold.
 fn children_allowed(tag: &str) -> &'static [&'static str] {
     match tag {
-        "body" | "ground" => &["marker"],
+        "body" | "flexible_body" | "ground" => &["marker"],
         "linearization" => &["state", "velocity"],
         _ => &[],
     }
@@ -71,6 +76,7 @@ impl<'a> Loader<'a> {
                 "gravity",
                 "ground",
                 "body",
+                "flexible_body",
                 "joint",
                 "motion",
                 "constraint",
@@ -209,7 +215,7 @@ impl<'a> Loader<'a> {
         match x.tag.as_str() {
             "parameter" => self.declare_bare(x, "parameter", NameRef::Param(next(&mut n.params))),
             "input" => self.declare_bare(x, "input", NameRef::Input(next(&mut n.inputs))),
-            "body" => self.declare_body(x, next(&mut n.bodies)),
+            "body" | "flexible_body" => self.declare_body(x, next(&mut n.bodies)),
             "ground" => self.declare_ground(x),
             "joint" => {
                 let k = next(&mut n.joints);

@@ -11,6 +11,7 @@
 mod attrs;
 mod build;
 mod build_constraints;
+mod build_flexible;
 mod build_forces;
 mod build_user;
 mod declare;
