@@ -4,6 +4,7 @@
 //! evaluating it with [`Dual`] numbers yields exact first derivatives, and with
 //! `Dual<Dual<f64, N>, N>` exact second derivatives. Nothing is finite-differenced.
 
+pub mod chunked;
 mod dual;
 mod real;
 

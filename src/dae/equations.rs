@@ -15,7 +15,6 @@ pub use super::layout::Layout;
 pub use super::residual::rhs;
 use super::sparse::Triplets;
 use crate::mechanics::System;
-use crate::mechanics::body::NQ;
 use crate::mechanics::mass::{body_mass_entries, constant_mass};
 
 /// The integrator's mass matrix diag(I, M, [I 0 0], 0, 0) of M y' = f; constant: it
@@ -26,10 +25,9 @@ pub fn mass_matrix(sys: &System, lay: Layout, m: &mut Triplets) {
         m.push(i, i, 1.0);
     }
     for b in 0..sys.nb() {
-        let o = lay.u() + NQ * b;
         if sys.acc_bodies.contains(&b) {
-            for c in 0..NQ {
-                m.push(o + c, o + c, 1.0); // u' = a
+            for g in sys.body_dofs(b) {
+                m.push(lay.u() + g, lay.u() + g, 1.0); // u' = a
             }
             continue;
         }

@@ -3,11 +3,14 @@
 
 use super::layout::Layout;
 use super::sparse::Triplets;
+use crate::ad::chunked;
 use crate::mechanics::System;
 use crate::mechanics::body::{NQ, h_angular, qdot};
-use crate::mechanics::constraint_jacobian::{global_column, p_row};
+use crate::mechanics::constraint_jacobian::p_row;
+use crate::mechanics::coords::{gather, global_column, nql};
+use crate::mechanics::flexible;
 use crate::mechanics::kernels::{
-    constraint_second, dhtw_dq, dqdot_dq, force_ext_jacobian, force_jacobian, gather, gyroscopic, nonholonomic_second,
+    constraint_second, dhtw_dq, dqdot_dq, force_ext_jacobian, force_jacobian, gyroscopic, nonholonomic_second,
     user_jacobian,
 };
 use crate::mechanics::loads::{LoadGradient, LoadTerm, NLOAD, load_gradient};
@@ -32,6 +35,7 @@ pub fn jacobian(sys: &System, lay: Layout, t: f64, y: &[f64], inputs: &[f64], ja
     let lc = LoadChain::new(sys, lay, y, t, &ext);
     user_rows(&at, &lc, jac);
     kinematic_rows(&at, jac);
+    flexible_rows(&at, jac);
     nonholonomic_rows(&at, jac);
     force_rows(&at, &lc, jac);
     constraint_rows(&at, jac);
@@ -48,9 +52,9 @@ fn user_rows(at: &At, lc: &LoadChain, jac: &mut Triplets) {
     for (k, ue) in sys.user.iter().enumerate() {
         let row = nz + lay.nx + k;
         let uj = user_jacobian(sys, ue, at.q, at.u, at.t, at.ext);
-        let nql = NQ * ue.bodies.len();
+        let nql = nql(sys, &ue.bodies);
         for a in 0..nql {
-            let g = global_column(&ue.bodies, a);
+            let g = global_column(sys, &ue.bodies, a);
             jac.push(row, g, uj.dqu[a]);
             jac.push(row, nu + g, uj.dqu[nql + a]);
         }
@@ -64,9 +68,13 @@ fn user_rows(at: &At, lc: &LoadChain, jac: &mut Triplets) {
     }
 }
 
-/// ∂/∂(q, u) of q̇ = H(q) u (Eq. 13b) and of the gyroscopic terms of Q, body by body.
+/// ∂/∂(q, u) of q̇ = H(q) u (Eq. 13b; η̇ = u_η for modal coordinates) and of the
+/// gyroscopic terms of Q of the rigid bodies, body by body.
 fn kinematic_rows(at: &At, jac: &mut Triplets) {
     let nu = at.lay.u();
+    for g in at.lay.body_cols..at.lay.n {
+        jac.push(g, nu + g, 1.0);
+    }
     for (b, body) in at.sys.bodies.iter().enumerate() {
         let o = NQ * b;
         let (qb, ub) = (&at.q[o..o + NQ], &at.u[o..o + NQ]);
@@ -86,10 +94,33 @@ fn kinematic_rows(at: &At, jac: &mut Triplets) {
                 jac.push(o + 3 + r, nu + o + 3 + c, h.0[r][c]);
             }
         }
+        if at.sys.flex_of(b).is_some() {
+            continue; // its inertia forces are in `flexible_rows`
+        }
         let (_, gj) = gyroscopic(&body.inertia, &ub[3..6]);
         for r in 0..3 {
             for c in 0..3 {
                 jac.push(nu + o + 3 + r, nu + o + 3 + c, gj[r * 3 + c]);
+            }
+        }
+    }
+}
+
+/// ∂/∂(q_b, u_b) of a flexible body's own forces (gravity, quadratic velocity, elastic,
+/// damping; [`flexible::body_forces`]), exact, seeded a chunk at a time.
+fn flexible_rows(at: &At, jac: &mut Triplets) {
+    let (sys, nu) = (at.sys, at.lay.u());
+    for fb in &sys.flex {
+        let dofs = sys.body_dofs(fb.body);
+        let nb = dofs.len();
+        let x: Vec<f64> = dofs.iter().map(|&g| at.q[g]).chain(dofs.iter().map(|&g| at.u[g])).collect();
+        let (_, j) = chunked::jacobian(&x, |x| {
+            flexible::body_forces(&fb.inv, &sys.r0[fb.body], sys.gravity, &x[..nb], &x[nb..])
+        });
+        for (r, &gr) in dofs.iter().enumerate() {
+            for (c, &gc) in dofs.iter().enumerate() {
+                jac.push(nu + gr, gc, j[r * 2 * nb + c]);
+                jac.push(nu + gr, nu + gc, j[r * 2 * nb + nb + c]);
             }
         }
     }
@@ -100,7 +131,7 @@ fn nonholonomic_rows(at: &At, jac: &mut Triplets) {
     let (nu, nn) = (at.lay.u(), at.lay.nu());
     for el in &at.sys.nonholonomic {
         let s = nonholonomic_second(at.sys, el, at.q, at.u, at.t, at.ext);
-        let (nql, k) = (NQ * el.bodies.len(), s.k);
+        let (nql, k) = (nql(at.sys, &el.bodies), s.k);
         let mut bq = vec![0.0; 2 * nql * nql]; // Σ ν_e ∂B_e/∂(q, u), rows = u entries
         for e in 0..el.neq {
             let row = nn + el.row + e;
@@ -108,7 +139,7 @@ fn nonholonomic_rows(at: &At, jac: &mut Triplets) {
             let hs = &s.hess[e * k * k..(e + 1) * k * k];
             let nu_e = at.y[row];
             for a in 0..nql {
-                let ga = global_column(&el.bodies, a);
+                let ga = global_column(at.sys, &el.bodies, a);
                 jac.push(row, ga, g[a]);
                 jac.push(row, nu + ga, g[nql + a]);
                 jac.push(nu + ga, row, -g[nql + a]);
@@ -120,9 +151,9 @@ fn nonholonomic_rows(at: &At, jac: &mut Triplets) {
             }
         }
         for a in 0..nql {
-            let ga = global_column(&el.bodies, a);
+            let ga = global_column(at.sys, &el.bodies, a);
             for c in 0..2 * nql {
-                let gc = global_column(&el.bodies, c % nql) + if c < nql { 0 } else { nu };
+                let gc = global_column(at.sys, &el.bodies, c % nql) + if c < nql { 0 } else { nu };
                 jac.push(nu + ga, gc, -bq[a * 2 * nql + c]);
             }
         }
@@ -134,12 +165,12 @@ fn force_rows(at: &At, lc: &LoadChain, jac: &mut Triplets) {
     let (sys, lay) = (at.sys, at.lay);
     let (nz, nu, ni) = (lay.z(), lay.u(), sys.ni());
     for el in &sys.forces {
-        let nql = NQ * el.bodies.len();
+        let nql = nql(at.sys, &el.bodies);
         let (_, fj) = force_jacobian(sys, el, at.q, at.u, at.t, at.ext);
         for r in 0..nql {
-            let gr = nu + global_column(&el.bodies, r);
+            let gr = nu + global_column(at.sys, &el.bodies, r);
             for a in 0..nql {
-                let ga = global_column(&el.bodies, a);
+                let ga = global_column(at.sys, &el.bodies, a);
                 jac.push(gr, ga, fj[r * 2 * nql + a]);
                 jac.push(gr, nu + ga, fj[r * 2 * nql + nql + a]);
             }
@@ -147,9 +178,9 @@ fn force_rows(at: &At, lc: &LoadChain, jac: &mut Triplets) {
         for (e, col) in force_ext_jacobian(sys, el, at.q, at.u, at.t, at.ext) {
             for (r, v) in col.iter().enumerate() {
                 if e >= ni + lay.nz() {
-                    lc.push(jac, nu + global_column(&el.bodies, r), e, *v);
+                    lc.push(jac, nu + global_column(at.sys, &el.bodies, r), e, *v);
                 } else if e >= ni {
-                    jac.push(nu + global_column(&el.bodies, r), nz + e - ni, *v);
+                    jac.push(nu + global_column(at.sys, &el.bodies, r), nz + e - ni, *v);
                 }
             }
         }
@@ -162,9 +193,9 @@ fn constraint_rows(at: &At, jac: &mut Triplets) {
     let (nl, nm) = (at.lay.lam(), at.lay.mu());
     for el in &at.sys.constraints {
         let s = constraint_second(at.sys, el, at.q, at.t, at.ext);
-        let nql = NQ * el.bodies.len();
+        let nql = nql(at.sys, &el.bodies);
         let k = s.k;
-        let rates = body_rates(&el.bodies, at.q, at.u);
+        let rates = body_rates(at.sys, &el.bodies, at.q, at.u);
         let mut lq = vec![0.0; nql * nql];
         for e in 0..el.neq {
             let row = el.row + e;
@@ -178,7 +209,7 @@ fn constraint_rows(at: &At, jac: &mut Triplets) {
             let hs = &s.hess[e * k * k..(e + 1) * k * k];
             constraint_row(at, &el.bodies, row, g, hs, &rates, jac);
             if lam != 0.0 {
-                add_pt_lambda_q(&el.bodies, at.q, lam, g, hs, &mut lq);
+                add_pt_lambda_q(at.sys, &el.bodies, at.q, lam, g, hs, &mut lq);
             }
         }
         push_pt_lambda_q(at, &el.bodies, &lq, jac);
@@ -187,18 +218,17 @@ fn constraint_rows(at: &At, jac: &mut Triplets) {
 
 /// q̇ = H(q) u of an element's bodies and ∂q̇/∂q of each body.
 struct BodyRates {
-    /// q̇, local (6 per body).
+    /// q̇, local (6 per body, then the modal rates η̇).
     qd: Vec<f64>,
     /// ∂q̇/∂q of each body (6 × 6, row-major).
     dq: Vec<[f64; 36]>,
 }
 
 /// The [`BodyRates`] of `bodies` at global (q, u).
-fn body_rates(bodies: &[usize], q: &[f64], u: &[f64]) -> BodyRates {
-    let nql = NQ * bodies.len();
-    let ql = gather(bodies, q);
-    let ul = gather(bodies, u);
-    let mut qd = vec![0.0; nql];
+fn body_rates(sys: &System, bodies: &[usize], q: &[f64], u: &[f64]) -> BodyRates {
+    let ql = gather(sys, bodies, q);
+    let ul = gather(sys, bodies, u);
+    let mut qd = ul.clone();
     let mut dq = Vec::with_capacity(bodies.len());
     for kb in 0..bodies.len() {
         let r = NQ * kb..NQ * kb + NQ;
@@ -213,23 +243,25 @@ fn body_rates(bodies: &[usize], q: &[f64], u: &[f64]) -> BodyRates {
 /// (q̇ rows), −Pᵀ in its λ column (u rows), P and Ċ_q in its μ row.
 fn constraint_row(at: &At, bodies: &[usize], row: usize, g: &[f64], hs: &[f64], rates: &BodyRates, jac: &mut Triplets) {
     let (nu, nl, nm) = (at.lay.u(), at.lay.lam(), at.lay.mu());
-    let (nql, k) = (NQ * bodies.len(), g.len());
+    let (nql, k) = (nql(at.sys, bodies), g.len());
     let p = p_row(bodies, at.q, &g[..nql]);
     for a in 0..nql {
-        let ga = global_column(bodies, a);
+        let ga = global_column(at.sys, bodies, a);
         // C_q (Eq. 13e rows), −C_qᵀ (q̇ rows, μ column), −Pᵀ (u rows, λ column), P (Ċ rows).
         jac.push(nl + row, ga, g[a]);
         jac.push(ga, nm + row, -g[a]);
         jac.push(nu + ga, nl + row, -p[a]);
         jac.push(nm + row, nu + ga, p[a]);
-        // Ċ_q = Σ_c C_qc,qa q̇_c + C_q ∂q̇/∂q_a + C_t,qa.
+        // Ċ_q = Σ_c C_qc,qa q̇_c + C_q ∂q̇/∂q_a + C_t,qa (a modal rate η̇ does not depend on q).
         let kb = a / NQ;
         let mut v = hs[a * k + nql];
         for c in 0..nql {
             v += hs[c * k + a] * rates.qd[c];
         }
-        for c in 0..NQ {
-            v += g[NQ * kb + c] * rates.dq[kb][c * 6 + a % NQ];
+        if kb < bodies.len() {
+            for c in 0..NQ {
+                v += g[NQ * kb + c] * rates.dq[kb][c * 6 + a % NQ];
+            }
         }
         jac.push(nm + row, ga, v);
     }
@@ -237,8 +269,8 @@ fn constraint_row(at: &At, bodies: &[usize], row: usize, g: &[f64], hs: &[f64], 
 
 /// Add one equation's (Pᵀλ)_q = λ [Hᵀ ∂C_q/∂q + ∂(Hᵀ w)/∂q |_{w = C_q}] to `lq` (local,
 /// row-major nql × nql), from its gradient `g` and Hessian `hs`.
-fn add_pt_lambda_q(bodies: &[usize], q: &[f64], lam: f64, g: &[f64], hs: &[f64], lq: &mut [f64]) {
-    let (nql, k) = (NQ * bodies.len(), g.len());
+fn add_pt_lambda_q(sys: &System, bodies: &[usize], q: &[f64], lam: f64, g: &[f64], hs: &[f64], lq: &mut [f64]) {
+    let (nql, k) = (nql(sys, bodies), g.len());
     for a in 0..nql {
         let col: Vec<f64> = (0..nql).map(|c| hs[c * k + a]).collect();
         let ht = p_row(bodies, q, &col);
@@ -259,10 +291,10 @@ fn add_pt_lambda_q(bodies: &[usize], q: &[f64], lam: f64, g: &[f64], hs: &[f64],
 /// Push −(Pᵀλ)_q of an element (`lq`, local, from [`add_pt_lambda_q`]) into its bodies'
 /// u rows and q columns.
 fn push_pt_lambda_q(at: &At, bodies: &[usize], lq: &[f64], jac: &mut Triplets) {
-    let (nu, nql) = (at.lay.u(), NQ * bodies.len());
+    let (nu, nql) = (at.lay.u(), nql(at.sys, bodies));
     for r in 0..nql {
         for a in 0..nql {
-            jac.push(nu + global_column(bodies, r), global_column(bodies, a), -lq[r * nql + a]);
+            jac.push(nu + global_column(at.sys, bodies, r), global_column(at.sys, bodies, a), -lq[r * nql + a]);
         }
     }
 }
@@ -275,10 +307,11 @@ fn acceleration_rows(at: &At, jac: &mut Triplets) {
         return;
     }
     let nu = lay.u();
+    let acc = |g: usize| lay.acc_row(&sys.acc_bodies, g).expect("a velocity of an acceleration body");
     let mut row_of = std::collections::HashMap::new();
-    for (k, &b) in sys.acc_bodies.iter().enumerate() {
-        for c in 0..NQ {
-            row_of.insert(nu + NQ * b + c, lay.acc() + NQ * k + c);
+    for &b in &sys.acc_bodies {
+        for g in sys.body_dofs(b) {
+            row_of.insert(nu + g, acc(g));
         }
     }
     for p in jac.idx.iter_mut() {
@@ -286,13 +319,28 @@ fn acceleration_rows(at: &At, jac: &mut Triplets) {
             p.row = r;
         }
     }
-    for (k, &b) in sys.acc_bodies.iter().enumerate() {
-        let (o, ra) = (NQ * b, lay.acc() + NQ * k);
+    for &b in &sys.acc_bodies {
         for (r, c, v) in body_mass_entries(sys, b, at.q) {
-            jac.push(ra + r - o, ra + c - o, -v);
+            jac.push(acc(r), acc(c), -v);
         }
-        for c in 0..NQ {
-            jac.push(nu + o + c, ra + c, 1.0);
+        for g in sys.body_dofs(b) {
+            jac.push(nu + g, acc(g), 1.0);
+        }
+        if let Some(fb) = sys.flex_of(b) {
+            // −∂(M(q) a)/∂q: a flexible body's mass depends on its orientation and η.
+            let dofs = sys.body_dofs(b);
+            let a: Vec<f64> = dofs.iter().map(|&g| at.y[acc(g)]).collect();
+            let qb: Vec<f64> = dofs.iter().map(|&g| at.q[g]).collect();
+            let (_, j) = chunked::jacobian(&qb, |x| {
+                let ad: Vec<crate::ad::Dual<f64, { chunked::CHUNK }>> =
+                    a.iter().map(|&v| crate::ad::Real::cst(v)).collect();
+                flexible::body_mass_times(&fb.inv, &sys.r0[b], x, &ad)
+            });
+            for (r, &gr) in dofs.iter().enumerate() {
+                for (c, &gc) in dofs.iter().enumerate() {
+                    jac.push(acc(gr), gc, -j[r * dofs.len() + c]);
+                }
+            }
         }
     }
 }

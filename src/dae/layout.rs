@@ -26,8 +26,14 @@ pub struct Layout {
     pub nv: usize,
     /// Non-holonomic equations (multipliers ν).
     pub mn: usize,
-    /// Acceleration unknowns a (6 per body whose accelerations forces or user rows read).
+    /// Acceleration unknowns a: 6 per acceleration body (`System::acc_bodies`: every
+    /// flexible body, and every body whose accelerations forces or user rows read), then
+    /// the modal accelerations η̈ of the flexible bodies.
     pub na: usize,
+    /// Number of body (non-modal) coordinates: 6 per body; the modal ones follow.
+    pub body_cols: usize,
+    /// Number of rigid-motion acceleration unknowns: 6 per acceleration body.
+    pub acc_rigid: usize,
 }
 
 /// What one entry of y is (index within its part).
@@ -50,7 +56,8 @@ pub enum Slot {
 impl Layout {
     /// The layout of a system's equations.
     pub fn of(sys: &System) -> Layout {
-        Layout { n: sys.n(), m: sys.m, nx: sys.nx, nv: sys.nv, mn: sys.mn, na: NQ * sys.acc_bodies.len() }
+        let (n, body_cols, acc_rigid) = (sys.n(), NQ * sys.nb(), NQ * sys.acc_bodies.len());
+        Layout { n, m: sys.m, nx: sys.nx, nv: sys.nv, mn: sys.mn, na: acc_rigid + n - body_cols, body_cols, acc_rigid }
     }
     /// Number of user unknowns Z = (X, Ẋ, V, a).
     pub fn nz(&self) -> usize {
@@ -159,10 +166,16 @@ impl Layout {
     /// a body with acceleration unknowns (`acc_bodies`) its algebraic row
     /// M a = Q − Pᵀλ − Bᵀν among the user rows.
     pub fn force_row(&self, acc_bodies: &[usize], g: usize) -> usize {
-        match acc_bodies.iter().position(|&b| b == g / NQ) {
-            Some(k) => self.acc() + NQ * k + g % NQ,
-            None => self.u() + g,
+        self.acc_row(acc_bodies, g).unwrap_or(self.u() + g)
+    }
+    /// Where in y the acceleration unknown of velocity `g` lives, if its body has
+    /// acceleration unknowns: six per acceleration body in `acc_bodies` order, then the
+    /// modal accelerations (every modal coordinate's body has them).
+    pub fn acc_row(&self, acc_bodies: &[usize], g: usize) -> Option<usize> {
+        if g >= self.body_cols {
+            return Some(self.acc() + self.acc_rigid + g - self.body_cols);
         }
+        acc_bodies.iter().position(|&b| b == g / NQ).map(|k| self.acc() + NQ * k + g % NQ)
     }
     /// A state vector y from its parts (μ = 0); `multipliers` holds λ then ν.
     pub fn assemble(&self, q: &[f64], u: &[f64], z: &[f64], multipliers: &[f64]) -> Vec<f64> {

@@ -91,11 +91,17 @@ impl Simulator {
         let mut e = 0.0;
         for (b, body) in s.bodies.iter().enumerate() {
             e += body_kinetic_energy(s, b, q, u);
-            e -= body.mass * (0..3).map(|c| s.gravity[c] * q[NQ * b + c]).sum::<f64>();
+            match s.flex_of(b) {
+                Some(f) => {
+                    let qb = crate::mechanics::coords::gather(s, &[b], q);
+                    e += crate::mechanics::flexible::potential(&f.inv, &s.r0[b], s.gravity, &qb);
+                }
+                None => e -= body.mass * (0..3).map(|c| s.gravity[c] * q[NQ * b + c]).sum::<f64>(),
+            }
         }
         for el in &s.forces {
-            let ql = crate::mechanics::kernels::gather(&el.bodies, q);
-            let ul = crate::mechanics::kernels::gather(&el.bodies, u);
+            let ql = crate::mechanics::coords::gather(s, &el.bodies, q);
+            let ul = crate::mechanics::coords::gather(s, &el.bodies, u);
             let inputs = self.ext();
             let ctx = LocalCtx::new(s, &el.bodies, &ql, &ul, &[], self.radau.t, &inputs);
             e += el.potential(&ctx);
@@ -110,7 +116,14 @@ impl Simulator {
         let s = &self.dae.sys;
         let mut v: Vec<String> =
             s.bodies.iter().flat_map(|b| qn.iter().map(move |c| format!("{}.{c}", b.name))).collect();
+        let modal = |prefix: &'static str| {
+            s.flex
+                .iter()
+                .flat_map(move |f| (1..=f.eta.len()).map(move |k| format!("{}.{prefix}{k}", s.bodies[f.body].name)))
+        };
+        v.extend(modal("eta"));
         v.extend(s.bodies.iter().flat_map(|b| un.iter().map(move |c| format!("{}.{c}", b.name))));
+        v.extend(modal("etadot"));
         v
     }
 

@@ -66,7 +66,7 @@ impl DaeProblem for MultibodyDae {
         let inputs = ext;
         for k in 0..self.sys.forces.len() {
             let el = &self.sys.forces[k];
-            let ql = crate::mechanics::kernels::gather(&el.bodies, &y[qs.clone()]);
+            let ql = crate::mechanics::coords::gather(&self.sys, &el.bodies, &y[qs.clone()]);
             let ctx = LocalCtx::new(&self.sys, &el.bodies, &ql, &[], &[], t, &inputs);
             if let Some(a) = el.angle(&ctx) {
                 self.sys.forces[k].angle_ref = a;

@@ -4,13 +4,24 @@
 use super::layout::Layout;
 use crate::mechanics::System;
 use crate::mechanics::body::{NQ, qdot};
-use crate::mechanics::constraint_jacobian::{constraint_jacobian, global_column};
+use crate::mechanics::constraint_jacobian::constraint_jacobian;
+use crate::mechanics::coords::{gather, global_column};
+use crate::mechanics::flexible;
 use crate::mechanics::kernels::{force_values, gyroscopic, nonholonomic_second, user_residual};
 use crate::mechanics::mass::body_mass_times;
 
 /// Applied generalized forces Q(u, q, t): gravity, gyroscopic terms and force elements.
 pub fn applied_forces(sys: &System, q: &[f64], u: &[f64], t: f64, inputs: &[f64], out: &mut [f64]) {
     for (b, body) in sys.bodies.iter().enumerate() {
+        if let Some(fb) = sys.flex_of(b) {
+            // Gravity, quadratic-velocity, elastic and damping forces of a flexible body.
+            let (qb, ub) = (gather(sys, &[b], q), gather(sys, &[b], u));
+            let fq = flexible::body_forces(&fb.inv, &sys.r0[b], sys.gravity, &qb, &ub);
+            for (g, v) in sys.body_dofs(b).into_iter().zip(fq) {
+                out[g] = v;
+            }
+            continue;
+        }
         let o = NQ * b;
         for c in 0..3 {
             out[o + c] = body.mass * sys.gravity[c];
@@ -21,7 +32,7 @@ pub fn applied_forces(sys: &System, q: &[f64], u: &[f64], t: f64, inputs: &[f64]
     for el in &sys.forces {
         let v = force_values(sys, el, q, u, t, inputs);
         for (a, x) in v.iter().enumerate() {
-            out[global_column(&el.bodies, a)] += x;
+            out[global_column(sys, &el.bodies, a)] += x;
         }
     }
 }
@@ -35,6 +46,8 @@ pub fn rhs(sys: &System, lay: Layout, t: f64, y: &[f64], inputs: &[f64], f: &mut
         let o = NQ * b;
         f[o..o + NQ].copy_from_slice(&qdot(&q[o..o + NQ], &u[o..o + NQ])); // Eq. 13b
     }
+    let modal = NQ * sys.nb()..lay.n;
+    f[modal.clone()].copy_from_slice(&u[modal]); // η̇ = u_η
     applied_forces(sys, q, u, t, &ext, &mut f[lay.u_range()]);
     nonholonomic_rows(sys, lay, t, y, &ext, f);
     constraint_rows(sys, lay, t, y, &ext, f);
@@ -56,12 +69,12 @@ fn nonholonomic_rows(sys: &System, lay: Layout, t: f64, y: &[f64], ext: &[f64], 
     let (q, u, nu, nn) = (&y[lay.q_range()], &y[lay.u_range()], lay.u(), lay.nu());
     for el in &sys.nonholonomic {
         let s = nonholonomic_second(sys, el, q, u, t, ext);
-        let nql = NQ * el.bodies.len();
+        let nql = crate::mechanics::coords::nql(sys, &el.bodies);
         for e in 0..el.neq {
             let nu_e = y[nn + el.row + e];
             f[nn + el.row + e] = s.c[e];
             for a in 0..nql {
-                f[nu + global_column(&el.bodies, a)] -= s.grad[e * s.k + nql + a] * nu_e;
+                f[nu + global_column(sys, &el.bodies, a)] -= s.grad[e * s.k + nql + a] * nu_e;
             }
         }
     }
@@ -98,12 +111,15 @@ fn constraint_rows(sys: &System, lay: Layout, t: f64, y: &[f64], ext: &[f64], f:
 /// (their force balance computed above moves there).
 fn acceleration_rows(sys: &System, lay: Layout, y: &[f64], f: &mut [f64]) {
     let q = &y[lay.q_range()];
-    for (k, &b) in sys.acc_bodies.iter().enumerate() {
-        let (o, ra) = (lay.u() + NQ * b, lay.acc() + NQ * k);
-        let ma = body_mass_times(sys, b, q, &y[ra..ra + NQ]);
-        for c in 0..NQ {
-            f[ra + c] = f[o + c] - ma[c];
-            f[o + c] = y[ra + c];
+    for &b in &sys.acc_bodies {
+        let dofs = sys.body_dofs(b);
+        let rows: Vec<usize> = dofs.iter().map(|&g| lay.force_row(&sys.acc_bodies, g)).collect();
+        let a: Vec<f64> = rows.iter().map(|&r| y[r]).collect();
+        let ma = body_mass_times(sys, b, q, &a);
+        for ((&g, &ra), m) in dofs.iter().zip(&rows).zip(ma) {
+            let o = lay.u() + g;
+            f[ra] = f[o] - m;
+            f[o] = y[ra];
         }
     }
 }

@@ -9,7 +9,6 @@ use super::problem::MultibodyDae;
 use super::radau::{DaeProblem, Radau, Stats};
 use super::sparse::SparseLu;
 use crate::mechanics::System;
-use crate::mechanics::body::NQ;
 use crate::model::{Model, ModelError};
 
 /// A running simulation of one model.
@@ -156,8 +155,11 @@ impl Simulator {
         let mut z = self.user_values().to_vec();
         // Acceleration unknowns: those of the same solve as λ.
         if let Some((udot, _)) = &self.acc {
-            for (k, &b) in self.dae.sys.acc_bodies.iter().enumerate() {
-                z[lay.acc_in_z(k)].copy_from_slice(&udot[NQ * b..NQ * (b + 1)]);
+            let sys = &self.dae.sys;
+            for &b in &sys.acc_bodies {
+                for g in sys.body_dofs(b) {
+                    z[lay.acc_row(&sys.acc_bodies, g).expect("an acceleration body") - lay.z()] = udot[g];
+                }
             }
         }
         self.dae.sys.ext(&self.dae.inputs_at(t), &z, Some(state), t)

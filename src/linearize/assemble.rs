@@ -8,8 +8,8 @@ use super::operating_point::OperatingPoint;
 use crate::dae::equations::jacobian;
 use crate::dae::layout::Slot;
 use crate::dae::sparse::Triplets;
-use crate::mechanics::body::NQ;
-use crate::mechanics::constraint_jacobian::global_column;
+use crate::mechanics::System;
+use crate::mechanics::coords::{global_column, nql};
 use crate::mechanics::mass::{body_mass_entries, constant_mass};
 
 /// The matrix of Eq. 34, with the values of the position and velocity states (S, then W)
@@ -90,7 +90,7 @@ fn mass_rows(p: &OperatingPoint, k: &mut Triplets) {
     let (sys, eq) = (p.sys, &p.eq);
     for b in 0..sys.nb() {
         if sys.acc_bodies.contains(&b) {
-            for g in NQ * b..NQ * (b + 1) {
+            for g in sys.body_dofs(b) {
                 k.push(eq.row_at(Equation::Eq34a, g), eq.at(Unknown::UDot, g), 1.0);
             }
             continue;
@@ -111,10 +111,20 @@ enum Through {
 
 /// Push `sign` · a local gradient `dz` over (q, u[, u̇]) of `bodies` (6 entries per body
 /// and level) into `row`.
-fn push_gradient(eq: &Eq34, k: &mut Triplets, row: usize, bodies: &[usize], dz: &[f64], sign: f64, to: Through) {
-    let nql = NQ * bodies.len();
+#[allow(clippy::too_many_arguments)]
+fn push_gradient(
+    sys: &System,
+    eq: &Eq34,
+    k: &mut Triplets,
+    row: usize,
+    bodies: &[usize],
+    dz: &[f64],
+    sign: f64,
+    to: Through,
+) {
+    let nql = nql(sys, bodies);
     for a in 0..nql {
-        let g = global_column(bodies, a);
+        let g = global_column(sys, bodies, a);
         k.push(row, eq.at(Unknown::Q, g), sign * dz[a]);
         k.push(row, eq.at(Unknown::U, g), sign * dz[nql + a]);
         if to == Through::Accelerations {
@@ -133,14 +143,14 @@ fn acceleration_constraint_rows(p: &OperatingPoint, k: &mut Triplets) {
             if sys.redundant[el.row + e] {
                 k.push(row, eq.at(Unknown::Lambda, el.row + e), 1.0);
             } else {
-                push_gradient(eq, k, row, &el.bodies, &jet.dg2, 1.0, Through::Accelerations);
+                push_gradient(sys, eq, k, row, &el.bodies, &jet.dg2, 1.0, Through::Accelerations);
             }
         }
     }
     for el in &sys.nonholonomic {
         for (e, jet) in jets(sys, el, &p.q, &p.u, &p.udot, p.t, &p.ext).iter().enumerate() {
             let row = eq.row_at(Equation::Eq34c, eq.m + el.row + e);
-            push_gradient(eq, k, row, &el.bodies, &jet.dg1, 1.0, Through::Accelerations);
+            push_gradient(sys, eq, k, row, &el.bodies, &jet.dg1, 1.0, Through::Accelerations);
         }
     }
 }
@@ -155,18 +165,18 @@ fn state_rows(p: &OperatingPoint, k: &mut Triplets) -> Vec<f64> {
         let jet = &jets(sys, st, &p.q, &p.u, &p.udot, p.t, &p.ext)[0];
         values.push(jet.g);
         k.push(eq.row_at(Eq34f, i), eq.at(Unknown::S, i), 1.0);
-        push_gradient(eq, k, eq.row_at(Eq34f, i), &st.bodies, &jet.dg, -1.0, Through::Velocities);
+        push_gradient(sys, eq, k, eq.row_at(Eq34f, i), &st.bodies, &jet.dg, -1.0, Through::Velocities);
         k.push(eq.row_at(Eq34g, i), eq.at(Unknown::SDot, i), 1.0);
-        push_gradient(eq, k, eq.row_at(Eq34g, i), &st.bodies, &jet.dg1, -1.0, Through::Velocities);
+        push_gradient(sys, eq, k, eq.row_at(Eq34g, i), &st.bodies, &jet.dg1, -1.0, Through::Velocities);
         k.push(eq.row_at(Eq34k, i), eq.at(Unknown::S, i), 1.0);
     }
     for (i, ws) in p.sel.velocities.iter().enumerate() {
         let jet = ws.jet(sys, &p.q, &p.u, &p.udot, p.t, &p.ext);
         values.push(jet.w);
         k.push(eq.row_at(Eq34h, i), eq.at(Unknown::W, i), 1.0);
-        push_gradient(eq, k, eq.row_at(Eq34h, i), ws.bodies(), &jet.dw, -1.0, Through::Velocities);
+        push_gradient(sys, eq, k, eq.row_at(Eq34h, i), ws.bodies(), &jet.dw, -1.0, Through::Velocities);
         k.push(eq.row_at(Eq34i, i), eq.at(Unknown::WDot, i), 1.0);
-        push_gradient(eq, k, eq.row_at(Eq34i, i), ws.bodies(), &jet.dwd, -1.0, Through::Accelerations);
+        push_gradient(sys, eq, k, eq.row_at(Eq34i, i), ws.bodies(), &jet.dwd, -1.0, Through::Accelerations);
         k.push(eq.row_at(Eq34j, i), eq.at(Unknown::W, i), 1.0);
     }
     values

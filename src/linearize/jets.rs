@@ -84,12 +84,15 @@ pub fn jets<F: PositionFn>(
     t: f64,
     inputs: &[f64],
 ) -> Vec<Jet> {
-    match f.bodies().len() {
-        0 => jets_k::<1, F>(sys, f, q, u, udot, t, inputs),
-        1 => jets_k::<19, F>(sys, f, q, u, udot, t, inputs),
-        2 => jets_k::<37, F>(sys, f, q, u, udot, t, inputs),
-        3 => jets_k::<55, F>(sys, f, q, u, udot, t, inputs),
-        _ => jets_k::<73, F>(sys, f, q, u, udot, t, inputs),
+    // q, u and u̇ of every local coordinate, and t.
+    match 3 * crate::mechanics::coords::nql(sys, f.bodies()) + 1 {
+        1 => jets_k::<1, F>(sys, f, q, u, udot, t, inputs),
+        2..=19 => jets_k::<19, F>(sys, f, q, u, udot, t, inputs),
+        20..=37 => jets_k::<37, F>(sys, f, q, u, udot, t, inputs),
+        38..=55 => jets_k::<55, F>(sys, f, q, u, udot, t, inputs),
+        56..=73 => jets_k::<73, F>(sys, f, q, u, udot, t, inputs),
+        74..=91 => jets_k::<91, F>(sys, f, q, u, udot, t, inputs),
+        _ => jets_k::<109, F>(sys, f, q, u, udot, t, inputs),
     }
 }
 
@@ -104,12 +107,12 @@ fn jets_k<const K: usize, F: PositionFn>(
 ) -> Vec<Jet> {
     type B<const K: usize> = Dual<f64, K>;
     let bodies = f.bodies();
-    let nq = NQ * bodies.len();
+    let nq = crate::mechanics::coords::nql(sys, bodies);
     let seed =
         |x: Vec<f64>, off: usize| -> Vec<B<K>> { x.iter().enumerate().map(|(i, &v)| B::var(v, off + i)).collect() };
-    let qb = seed(gather(bodies, q), 0);
-    let ub = seed(gather(bodies, u), nq);
-    let ab = seed(gather(bodies, udot), 2 * nq);
+    let qb = seed(gather(sys, bodies, q), 0);
+    let ub = seed(gather(sys, bodies, u), nq);
+    let ab = seed(gather(sys, bodies, udot), 2 * nq);
     let tb = B::<K>::var(t, 3 * nq);
     let mut qj = Vec::with_capacity(nq);
     let uj: Vec<_> =
@@ -124,6 +127,10 @@ fn jets_k<const K: usize, F: PositionFn>(
         for i in 0..NQ {
             qj.push(jet(qb[NQ * k + i], qd[i], qdd[i].d[0]));
         }
+    }
+    // Modal coordinates: η̇ and η̈ are their velocities and accelerations (H = I).
+    for i in NQ * bodies.len()..nq {
+        qj.push(jet(qb[i], ub[i], ab[i]));
     }
     let tj = jet(tb, B::one(), B::zero());
     let ctx = LocalCtx::new(sys, bodies, &qj, &uj, &[], tj, inputs);

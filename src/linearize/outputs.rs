@@ -21,6 +21,8 @@ pub struct OutputGradient {
     /// Bodies of the output and of every load it reads (global indices, ascending): the
     /// local order of `dz`.
     pub bodies: Vec<usize>,
+    /// Global column of each local coordinate (see [`crate::mechanics::coords`]).
+    pub cols: Vec<usize>,
     /// ∂y/∂(local q, u, u̇), loads chained in: q of each body of `bodies` (6 each), then u,
     /// then u̇; all NaN when it reads a load that has no value.
     pub dz: Vec<f64>,
@@ -69,7 +71,8 @@ pub fn output_gradient(sys: &System, e: &Expr, abase: usize, p: Point) -> Output
     let lift = |x: Vec<f64>| -> Vec<Dual<f64, 1>> { x.into_iter().map(Dual::cst).collect() };
     let mut dv: Vec<f64> = (0..p.inputs.len())
         .map(|k| {
-            let (ql, ul, al) = (lift(gather(&own, p.q)), lift(gather(&own, p.u)), lift(gather(&own, p.udot)));
+            let (ql, ul, al) =
+                (lift(gather(sys, &own, p.q)), lift(gather(sys, &own, p.u)), lift(gather(sys, &own, p.udot)));
             let mut ctx = LocalCtx::new(sys, &own, &ql, &ul, &al, Dual::cst(p.t), p.inputs);
             let seeded = p.inputs.iter().enumerate().map(|(i, &v)| if i == k { Dual::var(v, 0) } else { Dual::cst(v) });
             ctx.input_values = Some(seeded.collect());
@@ -116,7 +119,8 @@ pub fn output_gradient(sys: &System, e: &Expr, abase: usize, p: Point) -> Output
             });
         }
     }
-    OutputGradient { bodies, dz, dlam, dv }
+    let cols = crate::mechanics::coords::local_columns(sys, &bodies);
+    OutputGradient { bodies, cols, dz, dlam, dv }
 }
 
 /// ∂y/∂(the six components of element `r`'s load), the loads seeded as dual variables.
@@ -131,7 +135,7 @@ fn load_sensitivity(
 ) -> [f64; NLOAD] {
     type D = Dual<f64, NLOAD>;
     let lift = |x: Vec<f64>| -> Vec<D> { x.into_iter().map(D::cst).collect() };
-    let (ql, ul, al) = (lift(gather(own, p.q)), lift(gather(own, p.u)), lift(gather(own, p.udot)));
+    let (ql, ul, al) = (lift(gather(sys, own, p.q)), lift(gather(sys, own, p.u)), lift(gather(sys, own, p.udot)));
     let mut ctx = LocalCtx::new(sys, own, &ql, &ul, &al, D::cst(p.t), p.inputs);
     let loads = |f: LoadFn, x: ElementRef| {
         let v = value_of(f, x);
@@ -190,7 +194,8 @@ fn grad_k<const K: usize>(
             |i: usize, v: f64| if first.contains(&i) { Dual::var(v, off + i - first.start) } else { Dual::cst(v) };
         x.iter().enumerate().map(|(i, &v)| var(i, v)).collect()
     };
-    let (ql, ul, al) = (seed(gather(own, p.q), 0), seed(gather(own, p.u), nc), seed(gather(own, p.udot), 2 * nc));
+    let (ql, ul, al) =
+        (seed(gather(sys, own, p.q), 0), seed(gather(sys, own, p.u), nc), seed(gather(sys, own, p.udot), 2 * nc));
     let mut ctx = LocalCtx::new(sys, own, &ql, &ul, &al, Dual::cst(p.t), p.inputs);
     let loads = |f: LoadFn, r: ElementRef| Dual::cst(value_of(f, r));
     ctx.loads = Some(&loads);

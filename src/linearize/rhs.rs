@@ -5,7 +5,7 @@
 use super::assemble::equation_of;
 use super::eq34::{Eq34, Equation};
 use super::operating_point::OperatingPoint;
-use crate::mechanics::constraint_jacobian::global_column;
+use crate::mechanics::coords::global_column;
 use crate::mechanics::kernels::{force_ext_jacobian, user_jacobian};
 
 /// What a right-hand side (a column of A or B) differentiates with respect to.
@@ -51,7 +51,7 @@ impl RightHandSides {
             for (v, col) in force_ext_jacobian(sys, el, &p.q, &p.u, p.t, &p.ext) {
                 if v < ni {
                     for (a, &val) in col.iter().enumerate() {
-                        push(v, p.lay.force_row(&sys.acc_bodies, global_column(&el.bodies, a)), val);
+                        push(v, p.lay.force_row(&sys.acc_bodies, global_column(sys, &el.bodies, a)), val);
                     }
                 }
             }

@@ -13,7 +13,7 @@ use super::tiers::{CandidateRow, TierError, choose_in_tiers, constraint_rows, gr
 use super::tolerances::RANK_TOL;
 use crate::mechanics::System;
 use crate::mechanics::body::{NQ, block_times_t};
-use crate::mechanics::constraint_jacobian::global_column;
+use crate::mechanics::coords::{global_column, nql};
 use crate::mechanics::nonholonomic_jacobian::nonholonomic_b;
 use std::collections::BTreeMap;
 
@@ -77,8 +77,8 @@ pub fn select_velocities(
     };
     for (k, v) in user_velocities(sys).into_iter().enumerate() {
         let j = &jets(sys, &v, q, u, &zeros, t, ext)[0];
-        let nql = NQ * v.bodies.len();
-        let row = qdot_row(q, (0..nql).map(|a| (global_column(&v.bodies, a), j.dg[nql + a])));
+        let nql = nql(sys, &v.bodies);
+        let row = qdot_row(q, (0..nql).map(|a| (global_column(sys, &v.bodies, a), j.dg[nql + a])));
         push(0, VelState::User(v), VelOrigin::User(k), true, CandidateRow { entries: row })?;
     }
     for (i, Candidate { state: s, tier, user }) in pos.iter().enumerate() {

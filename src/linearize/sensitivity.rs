@@ -6,8 +6,6 @@ use super::eq34::{Eq34, Unknown};
 use super::operating_point::OperatingPoint;
 use super::outputs::{OutputGradient, output_gradient};
 use super::rhs::Column;
-use crate::mechanics::body::NQ;
-use crate::mechanics::constraint_jacobian::global_column;
 use crate::mechanics::external::{ExtEntry, ExtLayout};
 use crate::mechanics::loads::{LoadGradient, LoadTerm, load_gradient};
 
@@ -63,10 +61,9 @@ impl Sensitivities {
     /// zero and would carry only the LU's round-off.
     fn sensitivity(&self, g: &OutputGradient, x: &[f64], kinematic: bool) -> f64 {
         let eq = &self.eq;
-        let nql = NQ * g.bodies.len();
+        let nql = g.cols.len();
         let mut v = 0.0;
-        for a in 0..nql {
-            let gi = global_column(&g.bodies, a);
+        for (a, &gi) in g.cols.iter().enumerate() {
             if kinematic {
                 v += g.dz[a] * x[eq.at(Unknown::Q, gi)] + g.dz[nql + a] * x[eq.at(Unknown::U, gi)];
             }

@@ -8,7 +8,9 @@
 
 use super::body::{NQ, h_transpose_times, qdot};
 use super::constraints::ConstraintEl;
-use super::kernels::{constraint_first, constraint_second, dqdot_dq, gather};
+pub use super::coords::global_column;
+use super::coords::{gather, nql};
+use super::kernels::{constraint_first, constraint_second, dqdot_dq};
 use super::system::System;
 
 /// Constraint rows of a set of elements at (q, t).
@@ -20,17 +22,15 @@ pub struct ConstraintRows {
     pub ct: Vec<f64>,
     /// Entries (row, global column, value), row by row in element order.
     pub entries: Vec<(usize, usize, f64)>,
+    /// Number of body (non-modal) columns, 6 per body: columns from here on are modal
+    /// coordinates, whose velocities are their rates (H = I).
+    pub body_cols: usize,
 }
 
-/// Global column of local coordinate `a` of an element touching `bodies`.
-#[inline]
-pub fn global_column(bodies: &[usize], a: usize) -> usize {
-    NQ * bodies[a / NQ] + a % NQ
-}
-
-/// P row of one equation (local, 6 per body) from its C_q row: P = C_q H (Eq. 13a).
+/// P row of one equation (local coordinates, see [`super::coords`]) from its C_q row:
+/// P = C_q H (Eq. 13a); modal columns are unchanged (H = I there).
 pub fn p_row(bodies: &[usize], q: &[f64], cq: &[f64]) -> Vec<f64> {
-    let mut p = vec![0.0; cq.len()];
+    let mut p = cq.to_vec();
     for (k, &b) in bodies.iter().enumerate() {
         let r = h_transpose_times(&q[NQ * b..NQ * b + NQ], &cq[NQ * k..NQ * k + NQ]);
         p[NQ * k..NQ * k + NQ].copy_from_slice(&r);
@@ -42,16 +42,17 @@ pub fn p_row(bodies: &[usize], q: &[f64], cq: &[f64]) -> Vec<f64> {
 /// external values.
 pub fn constraint_rows(sys: &System, els: &[ConstraintEl], q: &[f64], t: f64, ext: &[f64]) -> ConstraintRows {
     let nrows = els.iter().map(|e| e.row + e.neq).max().unwrap_or(0);
-    let mut out = ConstraintRows { c: vec![0.0; nrows], ct: vec![0.0; nrows], entries: Vec::new() };
+    let body_cols = NQ * sys.nb();
+    let mut out = ConstraintRows { c: vec![0.0; nrows], ct: vec![0.0; nrows], entries: Vec::new(), body_cols };
     for el in els {
         let f = constraint_first(sys, el, q, t, ext);
-        let nql = NQ * el.bodies.len();
+        let nql = nql(sys, &el.bodies);
         for e in 0..el.neq {
             let row = el.row + e;
             out.c[row] = f.c[e];
             out.ct[row] = f.ct[e];
             let cq = &f.cq[e * nql..(e + 1) * nql];
-            out.entries.extend(cq.iter().enumerate().map(|(a, &v)| (row, global_column(&el.bodies, a), v)));
+            out.entries.extend(cq.iter().enumerate().map(|(a, &v)| (row, global_column(sys, &el.bodies, a), v)));
         }
     }
     out
@@ -99,15 +100,24 @@ impl ConstraintRows {
     /// linear form in the velocities u (C and C_t unchanged).
     pub fn velocity_form(&self, q: &[f64]) -> ConstraintRows {
         let mut entries = Vec::with_capacity(self.entries.len());
-        // Every row holds NQ consecutive entries per body it touches (see `constraint_rows`).
-        for chunk in self.entries.chunks_exact(NQ) {
-            let (row, c0) = (chunk[0].0, chunk[0].1);
+        // Every row holds NQ consecutive entries per body it touches, then its modal
+        // entries, one each (see `constraint_rows` and `super::coords`).
+        let mut i = 0;
+        while i < self.entries.len() {
+            let (row, c0, v) = self.entries[i];
+            if c0 >= self.body_cols {
+                entries.push((row, c0, v));
+                i += 1;
+                continue;
+            }
+            let chunk = &self.entries[i..i + NQ];
             debug_assert!(chunk.iter().enumerate().all(|(k, e)| e.0 == row && e.1 == c0 + k));
             let cq: Vec<f64> = chunk.iter().map(|e| e.2).collect();
             let p = h_transpose_times(&q[c0..c0 + NQ], &cq);
             entries.extend(p.iter().enumerate().map(|(k, &v)| (row, c0 + k, v)));
+            i += NQ;
         }
-        ConstraintRows { c: self.c.clone(), ct: self.ct.clone(), entries }
+        ConstraintRows { c: self.c.clone(), ct: self.ct.clone(), entries, body_cols: self.body_cols }
     }
 
     /// The entries of the independent rows, renumbered compactly (see [`IndependentRows`]).
@@ -121,12 +131,13 @@ pub fn acceleration_rhs(sys: &System, q: &[f64], u: &[f64], t: f64, inputs: &[f6
     let mut gamma = vec![0.0; sys.m];
     for el in &sys.constraints {
         let s = constraint_second(sys, el, q, t, inputs);
-        let nql = NQ * el.bodies.len();
+        let nql = nql(sys, &el.bodies);
         let k = s.k;
-        let ql = gather(&el.bodies, q);
-        let ul = gather(&el.bodies, u);
-        // z' = (q̇, 1): γ = z'ᵀ ∇²C z' + C_q (∂q̇/∂q) q̇.
-        let mut zd = vec![1.0; k];
+        let ql = gather(sys, &el.bodies, q);
+        let ul = gather(sys, &el.bodies, u);
+        // z' = (q̇, 1): γ = z'ᵀ ∇²C z' + C_q (∂q̇/∂q) q̇; modal rates are η̇ (H = I).
+        let mut zd = ul.clone();
+        zd.push(1.0);
         let mut extra = vec![0.0; nql];
         for kb in 0..el.bodies.len() {
             let r = NQ * kb..NQ * kb + NQ;

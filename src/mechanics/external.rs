@@ -21,7 +21,8 @@ pub struct ExtLayout {
     pub nx: usize,
     /// Number of variables V.
     pub nv: usize,
-    /// Number of acceleration entries a: 6 per acceleration body (v̇, then ω̇' in body axes).
+    /// Number of acceleration entries a: 6 per acceleration body (v̇, then ω̇' in body
+    /// axes), then the modal accelerations η̈ of the flexible bodies (modal order).
     pub na: usize,
     /// Number of load entries L: NLOAD per load reference.
     pub nl: usize,
@@ -41,9 +42,9 @@ pub enum ExtEntry {
 
 impl ExtLayout {
     /// The layout for `ni` inputs, `nx` differential states, `nv` variables, `acc_bodies`
-    /// acceleration bodies and `load_refs` load references.
-    pub(super) fn new(ni: usize, nx: usize, nv: usize, acc_bodies: usize, load_refs: usize) -> ExtLayout {
-        ExtLayout { ni, nx, nv, na: NQ * acc_bodies, nl: NLOAD * load_refs }
+    /// acceleration bodies, `neta` modal coordinates and `load_refs` load references.
+    pub(super) fn new(ni: usize, nx: usize, nv: usize, acc_bodies: usize, neta: usize, load_refs: usize) -> ExtLayout {
+        ExtLayout { ni, nx, nv, na: NQ * acc_bodies + neta, nl: NLOAD * load_refs }
     }
     /// Index of input v_i.
     pub fn input(&self, i: usize) -> usize {
@@ -142,7 +143,8 @@ impl ExtLayout {
 impl System {
     /// Layout of the external values this system's elements read.
     pub fn ext_layout(&self) -> ExtLayout {
-        ExtLayout::new(self.input_names.len(), self.nx, self.nv, self.acc_bodies.len(), self.load_refs.len())
+        let neta = self.n() - NQ * self.nb();
+        ExtLayout::new(self.input_names.len(), self.nx, self.nv, self.acc_bodies.len(), neta, self.load_refs.len())
     }
     /// Number of inputs.
     pub fn ni(&self) -> usize {
@@ -170,7 +172,7 @@ mod tests {
 
     #[test]
     fn every_entry_is_where_its_index_says() {
-        let lay = ExtLayout::new(2, 3, 1, 2, 1);
+        let lay = ExtLayout::new(2, 3, 1, 2, 0, 1);
         assert_eq!((lay.nz(), lay.len()), (2 * 3 + 1 + 12, 2 + 19 + 6));
         assert_eq!((lay.z_range(), lay.loads_range()), (2..21, 21..27));
         let mut at = Vec::new();

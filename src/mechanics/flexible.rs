@@ -185,6 +185,47 @@ pub fn elastic<T: Real>(inv: &Invariants, eta: &[T], etad: &[T]) -> Vec<T> {
         .collect()
 }
 
+/// The body-frame rotation A = R0 · R313(ψ, θ, φ) of body coordinates `qb`.
+pub fn rotation<T: Real>(r0: &Mat3, qb: &[T]) -> M3<T> {
+    M3::cst(r0).mm(&crate::geom::rot313(qb[3], qb[4], qb[5]))
+}
+
+/// The body's own generalized forces Q_b − h (6 + n_m): gravity `g`, minus the
+/// quadratic-velocity vector, minus K η + C η̇ in the modal rows; `qb`, `ub` are the
+/// body's coordinates and velocities [r; ψθφ; η], [v; ω'; η̇].
+pub fn body_forces<T: Real>(inv: &Invariants, r0: &Mat3, g: [f64; 3], qb: &[T], ub: &[T]) -> Vec<T> {
+    let a = rotation(r0, qb);
+    let (eta, etad) = (&qb[6..], &ub[6..]);
+    let mut out = gravity(inv, &a, eta, g);
+    let h = quadratic_velocity(inv, &a, eta, &V3([ub[3], ub[4], ub[5]]), etad);
+    for (o, x) in out.iter_mut().zip(&h) {
+        *o -= *x;
+    }
+    for (o, x) in out[6..].iter_mut().zip(elastic(inv, eta, etad)) {
+        *o -= x;
+    }
+    out
+}
+
+/// M(q_b) a_b for the body's coordinates `qb` and accelerations `ab` = [v̇; ω̇'; η̈].
+pub fn body_mass_times<T: Real>(inv: &Invariants, r0: &Mat3, qb: &[T], ab: &[T]) -> Vec<T> {
+    mass_times(inv, &rotation(r0, qb), &qb[6..], ab)
+}
+
+/// Potential energy of gravity `g` and of the modal stiffness: −g·(m r + A S(η)) + ½ ηᵀKη.
+pub fn potential(inv: &Invariants, r0: &Mat3, g: [f64; 3], qb: &[f64]) -> f64 {
+    let a = rotation(r0, qb);
+    let eta = &qb[6..];
+    let s = deformed(inv, eta).s;
+    let first = V3([qb[0], qb[1], qb[2]]).mul_s(inv.mass) + a.mv(&s);
+    let k: f64 = eta
+        .iter()
+        .enumerate()
+        .map(|(l, x)| x * (0..inv.nm).map(|c| inv.stiffness[l * inv.nm + c] * eta[c]).sum::<f64>())
+        .sum();
+    -first.dot(&V3(g)) + 0.5 * k
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

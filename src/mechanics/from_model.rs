@@ -10,10 +10,12 @@ use super::constraints::{ConstraintEl, ConstraintKind, VelocityIc};
 use super::external::ExtLayout;
 use super::forces::{ForceEl, ForceKind};
 use super::joint_coords::{JointCoord, joint_coordinates};
+use super::kernels::MAX_LOCAL;
 use super::nonholonomic::{NonholonomicEl, NonholonomicKind};
-use super::system::{BodyProps, MarkerGeom, System};
+use super::system::{BodyProps, FlexBody, MarkerGeom, NodeShape, System};
 use super::user::{UserEq, UserKind};
 use crate::geom::{M3, V3};
+use crate::modal::invariants::Invariants;
 use crate::model::expr::{ElementRef, Expr, angle_count, deps};
 use crate::model::{MAX_ELEMENT_BODIES, Model, MotionDof, NumVec, Orientation};
 
@@ -23,14 +25,11 @@ type Reads<'a> = &'a dyn Fn(&[&Expr]) -> Vec<usize>;
 impl System {
     /// Build the system from a validated model.
     pub fn from_model(model: &Model) -> Result<System, String> {
-        if let Some(b) = model.bodies.iter().find(|b| b.flex.is_some()) {
-            return Err(format!(
-                "flexible body '{}' (line {}): the engine does not simulate flexible bodies yet \
-                 (the model and its modal data read; see MODEL_FORMAT.md)",
-                b.name, b.pos.line
-            ));
-        }
-        let bodies = bodies_and_initial_coordinates(model);
+        let mut bodies = bodies_and_initial_coordinates(model);
+        let flex = flexible_bodies(model);
+        let neta: usize = flex.iter().map(|f| f.eta.len()).sum();
+        bodies.q_init.resize(bodies.q_init.len() + neta, 0.0);
+        bodies.u_init.resize(bodies.u_init.len() + neta, 0.0);
         let markers = markers(model);
         let mut slots = AngleSlots::default();
         let (mut constraints, mut ic_constraints, ic_velocities) = constraints_and_ics(model, &markers, &mut slots);
@@ -39,11 +38,12 @@ impl System {
         let load_refs = load_references(model);
         let acc_bodies = acceleration_bodies(model, &markers);
         let (ni, nx, nv) = (model.inputs.len(), model.differentials.len(), model.variables.len());
-        let ext = ExtLayout::new(ni, nx, nv, acc_bodies.len(), load_refs.len());
+        let ext = ExtLayout::new(ni, nx, nv, acc_bodies.len(), neta, load_refs.len());
         let reads = |es: &[&Expr]| ext.read_by(&acc_bodies, &load_refs, &|m| markers[m].body, es);
         let forces = forces(model, &markers, &reads, &mut slots);
         let user = user_rows(model, &markers, &ext, &reads, &mut slots);
         check_elements(model, &nonholonomic, &load_refs, &user, &constraints, &forces)?;
+        check_flexible(model, &markers, &flex, &[&constraints, &ic_constraints], &forces, &nonholonomic, &user)?;
         let measures = measures(model, &mut slots);
         let nj = model.joints.len();
         let (nsd, nsf, ngf) = (model.spring_dampers.len(), model.sforces.len(), model.gforces.len());
@@ -84,6 +84,7 @@ impl System {
             outputs: model.outputs.iter().map(|o| o.function.clone()).collect(),
             q_init: bodies.q_init,
             u_init: bodies.u_init,
+            flex,
         })
     }
 }
@@ -151,8 +152,36 @@ fn markers(model: &Model) -> Vec<MarkerGeom> {
     model
         .markers
         .iter()
-        .map(|m| MarkerGeom { body: m.body, s: m.position.v3(), rot: orientation_matrix(&m.orientation) })
+        .map(|m| MarkerGeom {
+            body: m.body,
+            s: m.position.v3(),
+            rot: orientation_matrix(&m.orientation),
+            node: node_shape(model, m),
+        })
         .collect()
+}
+
+/// The mode shapes at a marker's node (markers of flexible bodies).
+fn node_shape(model: &Model, m: &crate::model::Marker) -> Option<NodeShape> {
+    let (b, i) = (m.body?, m.node?);
+    let data = &model.bodies[b].flex.as_ref()?.data;
+    let part = |o: usize| data.modes.iter().map(|s| [s[i][o], s[i][o + 1], s[i][o + 2]]).collect();
+    Some(NodeShape { phi: part(0), rho: part(3) })
+}
+
+/// The flexible bodies: their modal coordinates follow the six of every body in q, in
+/// body order (see [`super::coords`]).
+fn flexible_bodies(model: &Model) -> Vec<FlexBody> {
+    let mut next = NQ * model.bodies.len();
+    let mut out = Vec::new();
+    for (b, body) in model.bodies.iter().enumerate() {
+        if let Some(f) = &body.flex {
+            let nm = f.data.modes.len();
+            out.push(FlexBody { body: b, eta: next..next + nm, inv: Invariants::of(&f.data) });
+            next += nm;
+        }
+    }
+    out
 }
 
 /// The bodies (sorted, each once) of markers `ms` and of the markers the expressions
@@ -351,10 +380,10 @@ fn load_references(model: &Model) -> Vec<ElementRef> {
     load_refs
 }
 
-/// The bodies whose accelerations force and user elements read (`System::acc_bodies`),
-/// sorted, each once.
+/// The bodies whose accelerations force and user elements read, and every flexible body
+/// (its mass matrix depends on q) (`System::acc_bodies`), sorted, each once.
 fn acceleration_bodies(model: &Model, markers: &[MarkerGeom]) -> Vec<usize> {
-    let mut acc_bodies: Vec<usize> = Vec::new();
+    let mut acc_bodies: Vec<usize> = (0..model.bodies.len()).filter(|&b| model.bodies[b].flex.is_some()).collect();
     for e in force_and_user_exprs(model) {
         let d = deps(e);
         if d.level >= 2 {
@@ -489,6 +518,56 @@ fn check_elements(
     }
     if let Some(f) = forces.iter().find(|f| f.bodies.len() > most) {
         return Err(touches("force", &f.name, f.bodies.len()));
+    }
+    Ok(())
+}
+
+/// Elements touching flexible bodies: at most [`MAX_LOCAL`] local coordinates each (six
+/// per body, plus the modal ones), and no force or user row reads a flexible body's
+/// accelerations.
+fn check_flexible(
+    model: &Model,
+    markers: &[MarkerGeom],
+    flex: &[FlexBody],
+    constraints: &[&[ConstraintEl]],
+    forces: &[ForceEl],
+    nonholonomic: &[NonholonomicEl],
+    user: &[UserEq],
+) -> Result<(), String> {
+    if flex.is_empty() {
+        return Ok(());
+    }
+    let count = |bodies: &[usize]| {
+        NQ * bodies.len()
+            + bodies.iter().filter_map(|&b| flex.iter().find(|f| f.body == b)).map(|f| f.eta.len()).sum::<usize>()
+    };
+    let too_many = |what: &str, name: &str, bodies: &[usize]| {
+        let n = count(bodies);
+        (n > MAX_LOCAL).then(|| {
+            format!(
+                "{what} '{name}' has {n} coordinates (six per body it touches plus the modal ones; at most \
+                 {MAX_LOCAL}): use fewer modes"
+            )
+        })
+    };
+    let checks = constraints
+        .iter()
+        .flat_map(|cs| cs.iter().map(|c| too_many("constraint", &c.name, &c.bodies)))
+        .chain(forces.iter().map(|f| too_many("force", &f.name, &f.bodies)))
+        .chain(nonholonomic.iter().map(|c| too_many("constraint", &c.name, &c.bodies)))
+        .chain(user.iter().map(|u| too_many("user element", &u.name, &u.bodies)));
+    if let Some(e) = checks.flatten().next() {
+        return Err(e);
+    }
+    for e in force_and_user_exprs(model) {
+        let d = deps(e);
+        let flexible = d.markers.iter().filter_map(|&m| markers[m].body).find(|&b| model.bodies[b].flex.is_some());
+        if let (true, Some(b)) = (d.level >= 2, flexible) {
+            return Err(format!(
+                "a force or user element reads accelerations of flexible body '{}', which is not supported",
+                model.bodies[b].name
+            ));
+        }
     }
     Ok(())
 }

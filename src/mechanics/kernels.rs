@@ -2,19 +2,16 @@
 //! coordinates. Each kernel seeds the coordinates of the (few) bodies an element touches,
 //! so the cost is independent of the model size and every Jacobian stays sparse.
 
-use super::body::{NQ, h_transpose_times, qdot};
+use super::body::{h_transpose_times, qdot};
 use super::constraints::ConstraintEl;
+pub use super::coords::gather;
+use super::coords::nql;
 use super::forces::ForceEl;
 use super::local::LocalCtx;
 use super::nonholonomic::NonholonomicEl;
 use super::system::System;
 use super::user::UserEq;
 use crate::ad::{Dual, Real};
-
-/// Gather the local coordinates of `bodies` from a global vector (6 per body).
-pub fn gather(bodies: &[usize], x: &[f64]) -> Vec<f64> {
-    bodies.iter().flat_map(|&b| x[NQ * b..NQ * b + NQ].iter().copied()).collect()
-}
 
 /// C, C_q (local, row-major neq × 6nb) and C_t of one constraint element.
 pub struct ConstraintFirst {
@@ -38,21 +35,29 @@ pub struct ConstraintSecond {
     pub hess: Vec<f64>,
 }
 
-macro_rules! by_bodies {
-    ($nb:expr, $f:ident, $k1:literal, $k2:literal, $k3:literal, $k4:literal, $k0:literal ( $($a:expr),* )) => {
-        match $nb {
-            0 => $f::<$k0>($($a),*),
-            1 => $f::<$k1>($($a),*),
-            2 => $f::<$k2>($($a),*),
-            3 => $f::<$k3>($($a),*),
-            _ => $f::<$k4>($($a),*),
-        }
+/// Call `f::<K>` with the smallest width K of the list that holds `n` variables (the
+/// list ends at the widest the model reader allows: [`MAX_LOCAL`] local coordinates).
+macro_rules! by_width {
+    ($n:expr, $f:ident, [$($k:literal),+] ( $($a:expr),* )) => {{
+        let n: usize = $n;
+        by_width!(@go n, $f, [$($k),+] ($($a),*))
+    }};
+    (@go $n:ident, $f:ident, [$k:literal] ( $($a:expr),* )) => {{
+        assert!($n <= $k, "{} variables exceed the widest dual number ({})", $n, $k);
+        $f::<$k>($($a),*)
+    }};
+    (@go $n:ident, $f:ident, [$k:literal, $($rest:literal),+] ( $($a:expr),* )) => {
+        if $n <= $k { $f::<$k>($($a),*) } else { by_width!(@go $n, $f, [$($rest),+] ($($a),*)) }
     };
 }
 
+/// The most local coordinates an element may have (six per body it touches, plus the
+/// modal coordinates of the flexible ones): the widest dual numbers are built for it.
+pub const MAX_LOCAL: usize = 36;
+
 /// Constraint values only.
 pub fn constraint_values(sys: &System, el: &ConstraintEl, q: &[f64], t: f64, inputs: &[f64]) -> Vec<f64> {
-    let ql = gather(&el.bodies, q);
+    let ql = gather(sys, &el.bodies, q);
     let ctx = LocalCtx::new(sys, &el.bodies, &ql, &[], &[], t, inputs);
     let mut out = vec![0.0; el.neq];
     el.kind.eval(&ctx, &mut out);
@@ -61,12 +66,12 @@ pub fn constraint_values(sys: &System, el: &ConstraintEl, q: &[f64], t: f64, inp
 
 /// First derivatives of a constraint element (Eq. 1b: C_q, C_t).
 pub fn constraint_first(sys: &System, el: &ConstraintEl, q: &[f64], t: f64, inputs: &[f64]) -> ConstraintFirst {
-    by_bodies!(el.bodies.len(), first_k, 7, 13, 19, 25, 1(sys, el, q, t, inputs))
+    by_width!(nql(sys, &el.bodies) + 1, first_k, [1, 7, 13, 19, 25, 31, 37](sys, el, q, t, inputs))
 }
 
 fn first_k<const K: usize>(sys: &System, el: &ConstraintEl, q: &[f64], t: f64, inputs: &[f64]) -> ConstraintFirst {
-    let nq = NQ * el.bodies.len();
-    let ql: Vec<Dual<f64, K>> = gather(&el.bodies, q).iter().enumerate().map(|(k, &v)| Dual::var(v, k)).collect();
+    let nq = nql(sys, &el.bodies);
+    let ql: Vec<Dual<f64, K>> = gather(sys, &el.bodies, q).iter().enumerate().map(|(k, &v)| Dual::var(v, k)).collect();
     let ctx = LocalCtx::new(sys, &el.bodies, &ql, &[], &[], Dual::var(t, nq), inputs);
     let mut out = vec![Dual::zero(); el.neq];
     el.kind.eval(&ctx, &mut out);
@@ -81,17 +86,17 @@ fn first_k<const K: usize>(sys: &System, el: &ConstraintEl, q: &[f64], t: f64, i
 
 /// Second derivatives of a constraint element (for Ċ_q, (Pᵀλ)_q and the γ of Eq. 1c).
 pub fn constraint_second(sys: &System, el: &ConstraintEl, q: &[f64], t: f64, inputs: &[f64]) -> ConstraintSecond {
-    by_bodies!(el.bodies.len(), second_k, 7, 13, 19, 25, 1(sys, el, q, t, inputs))
+    by_width!(nql(sys, &el.bodies) + 1, second_k, [1, 7, 13, 19, 25, 31, 37](sys, el, q, t, inputs))
 }
 
 fn second_k<const K: usize>(sys: &System, el: &ConstraintEl, q: &[f64], t: f64, inputs: &[f64]) -> ConstraintSecond {
-    let nq = NQ * el.bodies.len();
+    let nq = nql(sys, &el.bodies);
     let k = nq + 1;
     let seed = |v: f64, i: usize| Dual::<Dual<f64, K>, K> {
         v: Dual::var(v, i),
         d: std::array::from_fn(|j| if j == i { Dual::one() } else { Dual::zero() }),
     };
-    let ql: Vec<_> = gather(&el.bodies, q).iter().enumerate().map(|(i, &v)| seed(v, i)).collect();
+    let ql: Vec<_> = gather(sys, &el.bodies, q).iter().enumerate().map(|(i, &v)| seed(v, i)).collect();
     let ctx = LocalCtx::new(sys, &el.bodies, &ql, &[], &[], seed(t, nq), inputs);
     let mut out = vec![Dual::zero(); el.neq];
     el.kind.eval(&ctx, &mut out);
@@ -118,12 +123,14 @@ pub fn nonholonomic_second(
     t: f64,
     ext: &[f64],
 ) -> ConstraintSecond {
-    match el.bodies.len() {
+    match nql(sys, &el.bodies) {
         0 => nh_second_k::<1, 1>(sys, el, q, u, t, ext),
-        1 => nh_second_k::<7, 6>(sys, el, q, u, t, ext),
-        2 => nh_second_k::<13, 12>(sys, el, q, u, t, ext),
-        3 => nh_second_k::<19, 18>(sys, el, q, u, t, ext),
-        _ => nh_second_k::<25, 24>(sys, el, q, u, t, ext),
+        1..=6 => nh_second_k::<7, 6>(sys, el, q, u, t, ext),
+        7..=12 => nh_second_k::<13, 12>(sys, el, q, u, t, ext),
+        13..=18 => nh_second_k::<19, 18>(sys, el, q, u, t, ext),
+        19..=24 => nh_second_k::<25, 24>(sys, el, q, u, t, ext),
+        25..=30 => nh_second_k::<31, 30>(sys, el, q, u, t, ext),
+        _ => nh_second_k::<37, 36>(sys, el, q, u, t, ext),
     }
 }
 
@@ -140,12 +147,12 @@ fn nh_second_k<const KQ: usize, const KU: usize>(
     t: f64,
     ext: &[f64],
 ) -> ConstraintSecond {
-    let nq = NQ * el.bodies.len();
+    let nq = nql(sys, &el.bodies);
     let k = 2 * nq + 1;
     type D2<const KQ: usize, const KU: usize> = Dual<Dual<f64, KQ>, KU>;
     let ql: Vec<D2<KQ, KU>> =
-        gather(&el.bodies, q).iter().enumerate().map(|(i, &v)| outer_cst(Dual::var(v, i))).collect();
-    let ul: Vec<D2<KQ, KU>> = gather(&el.bodies, u)
+        gather(sys, &el.bodies, q).iter().enumerate().map(|(i, &v)| outer_cst(Dual::var(v, i))).collect();
+    let ul: Vec<D2<KQ, KU>> = gather(sys, &el.bodies, u)
         .iter()
         .enumerate()
         .map(|(i, &v)| Dual {
@@ -183,9 +190,9 @@ fn nh_second_k<const KQ: usize, const KU: usize>(
 
 /// Generalized forces of one element on its bodies (6 per local body).
 pub fn force_values(sys: &System, el: &ForceEl, q: &[f64], u: &[f64], t: f64, inputs: &[f64]) -> Vec<f64> {
-    let (ql, ul) = (gather(&el.bodies, q), gather(&el.bodies, u));
+    let (ql, ul) = (gather(sys, &el.bodies, q), gather(sys, &el.bodies, u));
     let ctx = LocalCtx::new(sys, &el.bodies, &ql, &ul, &[], t, inputs);
-    let mut out = vec![0.0; NQ * el.bodies.len()];
+    let mut out = vec![0.0; nql(sys, &el.bodies)];
     el.generalized(&ctx, &mut out);
     out
 }
@@ -199,7 +206,7 @@ pub fn force_jacobian(
     t: f64,
     inputs: &[f64],
 ) -> (Vec<f64>, Vec<f64>) {
-    by_bodies!(el.bodies.len(), force_jac_k, 13, 25, 37, 49, 1(sys, el, q, u, t, inputs))
+    by_width!(2 * nql(sys, &el.bodies) + 1, force_jac_k, [1, 13, 25, 37, 49, 61, 73](sys, el, q, u, t, inputs))
 }
 
 fn force_jac_k<const K: usize>(
@@ -210,9 +217,10 @@ fn force_jac_k<const K: usize>(
     t: f64,
     inputs: &[f64],
 ) -> (Vec<f64>, Vec<f64>) {
-    let nq = NQ * el.bodies.len();
-    let ql: Vec<Dual<f64, K>> = gather(&el.bodies, q).iter().enumerate().map(|(k, &v)| Dual::var(v, k)).collect();
-    let ul: Vec<Dual<f64, K>> = gather(&el.bodies, u).iter().enumerate().map(|(k, &v)| Dual::var(v, nq + k)).collect();
+    let nq = nql(sys, &el.bodies);
+    let ql: Vec<Dual<f64, K>> = gather(sys, &el.bodies, q).iter().enumerate().map(|(k, &v)| Dual::var(v, k)).collect();
+    let ul: Vec<Dual<f64, K>> =
+        gather(sys, &el.bodies, u).iter().enumerate().map(|(k, &v)| Dual::var(v, nq + k)).collect();
     let ctx = LocalCtx::new(sys, &el.bodies, &ql, &ul, &[], Dual::cst(t), inputs);
     let mut out = vec![Dual::zero(); nq];
     el.generalized(&ctx, &mut out);
@@ -256,14 +264,14 @@ pub fn force_ext_jacobian(
     t: f64,
     ext: &[f64],
 ) -> Vec<(usize, Vec<f64>)> {
-    let (ql, ul) = (gather(&el.bodies, q), gather(&el.bodies, u));
+    let (ql, ul) = (gather(sys, &el.bodies, q), gather(sys, &el.bodies, u));
     el.ext_refs
         .iter()
         .map(|&k| {
             let (qd, ud) = (lift(&ql), lift(&ul));
             let mut ctx = LocalCtx::new(sys, &el.bodies, &qd, &ud, &[], Dual::cst(t), ext);
             ctx.input_values = Some(seed_ext(ext, k));
-            let mut out = vec![Dual::zero(); NQ * el.bodies.len()];
+            let mut out = vec![Dual::zero(); nql(sys, &el.bodies)];
             el.generalized(&ctx, &mut out);
             (k, out.iter().map(|e| e.d[0]).collect())
         })
@@ -282,7 +290,7 @@ fn seed_ext(ext: &[f64], k: usize) -> Vec<Dual<f64, 1>> {
 
 /// Residual of a user row (Eq. 7a–7b).
 pub fn user_residual(sys: &System, ue: &UserEq, q: &[f64], u: &[f64], t: f64, ext: &[f64]) -> f64 {
-    let (ql, ul) = (gather(&ue.bodies, q), gather(&ue.bodies, u));
+    let (ql, ul) = (gather(sys, &ue.bodies, q), gather(sys, &ue.bodies, u));
     ue.residual(&LocalCtx::new(sys, &ue.bodies, &ql, &ul, &[], t, ext))
 }
 
@@ -299,8 +307,9 @@ pub struct UserJacobian {
 
 /// Value and exact derivatives of a user row.
 pub fn user_jacobian(sys: &System, ue: &UserEq, q: &[f64], u: &[f64], t: f64, ext: &[f64]) -> UserJacobian {
-    let (value, dqu) = by_bodies!(ue.bodies.len(), user_qu_k, 12, 24, 36, 48, 1(sys, ue, q, u, t, ext));
-    let (ql, ul) = (gather(&ue.bodies, q), gather(&ue.bodies, u));
+    let (value, dqu) =
+        by_width!(2 * nql(sys, &ue.bodies), user_qu_k, [1, 12, 24, 36, 48, 60, 72](sys, ue, q, u, t, ext));
+    let (ql, ul) = (gather(sys, &ue.bodies, q), gather(sys, &ue.bodies, u));
     let dext = ue
         .ext_refs
         .iter()
@@ -315,9 +324,10 @@ pub fn user_jacobian(sys: &System, ue: &UserEq, q: &[f64], u: &[f64], t: f64, ex
 }
 
 fn user_qu_k<const K: usize>(sys: &System, ue: &UserEq, q: &[f64], u: &[f64], t: f64, ext: &[f64]) -> (f64, Vec<f64>) {
-    let nq = NQ * ue.bodies.len();
-    let ql: Vec<Dual<f64, K>> = gather(&ue.bodies, q).iter().enumerate().map(|(k, &v)| Dual::var(v, k)).collect();
-    let ul: Vec<Dual<f64, K>> = gather(&ue.bodies, u).iter().enumerate().map(|(k, &v)| Dual::var(v, nq + k)).collect();
+    let nq = nql(sys, &ue.bodies);
+    let ql: Vec<Dual<f64, K>> = gather(sys, &ue.bodies, q).iter().enumerate().map(|(k, &v)| Dual::var(v, k)).collect();
+    let ul: Vec<Dual<f64, K>> =
+        gather(sys, &ue.bodies, u).iter().enumerate().map(|(k, &v)| Dual::var(v, nq + k)).collect();
     let r = ue.residual(&LocalCtx::new(sys, &ue.bodies, &ql, &ul, &[], Dual::cst(t), ext));
     (r.v, r.d[..2 * nq].to_vec())
 }

@@ -13,10 +13,9 @@
 //! is itself a dual-number derivative, so constraint loads nest two levels).
 
 use super::body::{NQ, h_transpose_times};
-use super::constraint_jacobian::global_column;
 use super::constraints::{ConstraintEl, ConstraintKind};
+use super::coords::{gather, local_columns};
 use super::forces::ForceEl;
-use super::kernels::gather;
 use super::local::LocalCtx;
 use super::system::{ElementSlot, System};
 use crate::ad::{Dual, Real};
@@ -30,6 +29,8 @@ pub use super::load_components::{NLOAD, load_index};
 pub struct LoadGradient {
     /// Bodies of the element (global indices): the local order of `dz`.
     pub bodies: Vec<usize>,
+    /// Global column of each local coordinate (see [`super::coords`]).
+    pub cols: Vec<usize>,
     /// Force and torque on the i marker (ground; torque about the i origin).
     pub value: [f64; NLOAD],
     /// ∂load/∂(local q, local u): NLOAD rows of 12·nb (q of each body, then u), row-major.
@@ -64,9 +65,8 @@ impl LoadGradient {
     /// Every nonzero partial derivative of load component `c`, as (what, value): the
     /// chain rule of anything that reads this load walks these.
     pub fn terms(&self, c: usize, mut f: impl FnMut(LoadTerm, f64)) {
-        let nlb = NQ * self.bodies.len();
-        for a in 0..nlb {
-            let g = global_column(&self.bodies, a);
+        let nlb = self.cols.len();
+        for (a, &g) in self.cols.iter().enumerate() {
             f(LoadTerm::Q(g), self.dz[c * 2 * nlb + a]);
             f(LoadTerm::U(g), self.dz[c * 2 * nlb + nlb + a]);
         }
@@ -97,11 +97,11 @@ pub fn load_value(
     match sys.element_slot(e) {
         ElementSlot::Force(k) => {
             let el = sys.forces.get(k)?;
-            Some(force_load(sys, el, &gather(&el.bodies, q), &gather(&el.bodies, u), t, inputs, None))
+            Some(force_load(sys, el, &gather(sys, &el.bodies, q), &gather(sys, &el.bodies, u), t, inputs, None))
         }
         ElementSlot::Constraint(k) => {
             let el = sys.constraints.get(k)?;
-            constraint_load(sys, el, &gather(&el.bodies, q), &lam[el.row..el.row + el.neq], t, inputs)
+            constraint_load(sys, el, &gather(sys, &el.bodies, q), &lam[el.row..el.row + el.neq], t, inputs)
         }
     }
 }
@@ -119,7 +119,7 @@ pub fn load_gradient(
     match sys.element_slot(e) {
         ElementSlot::Force(k) => {
             let el = sys.forces.get(k)?;
-            let (ql, ul) = (gather(&el.bodies, q), gather(&el.bodies, u));
+            let (ql, ul) = (gather(sys, &el.bodies, q), gather(sys, &el.bodies, u));
             let (value, dz) = match el.bodies.len() {
                 0 => force_grad_k::<1>(sys, el, &ql, &ul, t, inputs),
                 1 => force_grad_k::<12>(sys, el, &ql, &ul, t, inputs),
@@ -128,11 +128,19 @@ pub fn load_gradient(
                 _ => force_grad_k::<48>(sys, el, &ql, &ul, t, inputs),
             };
             let dv = force_input_gradient(sys, el, &ql, &ul, t, inputs);
-            Some(LoadGradient { bodies: el.bodies.clone(), value, dz, lam_row: 0, dlam: vec![], dv })
+            Some(LoadGradient {
+                bodies: el.bodies.clone(),
+                cols: local_columns(sys, &el.bodies),
+                value,
+                dz,
+                lam_row: 0,
+                dlam: vec![],
+                dv,
+            })
         }
         ElementSlot::Constraint(k) => {
             let el = sys.constraints.get(k)?;
-            let ql = gather(&el.bodies, q);
+            let ql = gather(sys, &el.bodies, q);
             let lam = &lam[el.row..el.row + el.neq];
             let (value, dq, dlam) = match el.bodies.len() {
                 0 => return None,
@@ -148,7 +156,15 @@ pub fn load_gradient(
                 dz[c * 2 * nql..c * 2 * nql + nql].copy_from_slice(&dq[c * nql..(c + 1) * nql]);
             }
             let dv = vec![0.0; NLOAD * inputs.len()];
-            Some(LoadGradient { bodies: el.bodies.clone(), value, dz, lam_row: el.row, dlam, dv })
+            Some(LoadGradient {
+                bodies: el.bodies.clone(),
+                cols: local_columns(sys, &el.bodies),
+                value,
+                dz,
+                lam_row: el.row,
+                dlam,
+                dv,
+            })
         }
     }
 }

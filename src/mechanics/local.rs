@@ -3,6 +3,7 @@
 //! [`ExprEnv`] that expressions read.
 
 use super::body::{NQ, body_frame};
+use super::coords::local_modal_range;
 use super::external::ExtLayout;
 use super::load_components::load_index;
 use super::system::System;
@@ -59,12 +60,32 @@ pub struct LocalCtx<'a, T: Real> {
     /// When set, inputs and user unknowns read these (e.g. seeded dual numbers, same
     /// layout as `inputs`) instead of `inputs`.
     pub input_values: Option<Vec<T>>,
+    /// Per local body: its modal coordinates η, rates η̇ and accelerations η̈ (empty for a
+    /// rigid body; rates and accelerations zero when not given).
+    modal: Vec<[Vec<T>; 3]>,
+}
+
+/// A node marker's deflection in body axes: Σ_k v_k x_k over the modes.
+fn modal_sum<T: Real>(v: &[[f64; 3]], x: &[T]) -> V3<T> {
+    let mut s = V3::zero();
+    for (vk, &xk) in v.iter().zip(x) {
+        s = s + V3::cst(*vk).mul_s(xk);
+    }
+    s
 }
 
 impl<'a, T: Real> LocalCtx<'a, T> {
-    /// Build from local coordinates `q` (6 per body), velocities `u` and accelerations
-    /// `udot` (each 6 per body, may be empty = zero).
+    /// Build from local coordinates `q` (6 per body, then the modal coordinates of the
+    /// flexible ones: [`super::coords`]), velocities `u` and accelerations `udot` (same
+    /// layout, may be empty = zero).
     pub fn new(sys: &'a System, ids: &'a [usize], q: &[T], u: &[T], udot: &[T], t: T, inputs: &'a [f64]) -> Self {
+        let modal = (0..ids.len())
+            .map(|k| {
+                let r = local_modal_range(sys, ids, k);
+                let part = |x: &[T]| if x.is_empty() { vec![T::zero(); r.len()] } else { x[r.clone()].to_vec() };
+                [q[r.clone()].to_vec(), part(u), part(udot)]
+            })
+            .collect();
         let bodies = ids
             .iter()
             .enumerate()
@@ -88,7 +109,23 @@ impl<'a, T: Real> LocalCtx<'a, T> {
             angle_base: Cell::new(0),
             record: None,
             input_values: None,
+            modal,
         }
+    }
+
+    /// A node marker's body-frame offset p = s + Φt η, rotation θ = Φr η and their first
+    /// and second rates (None: the marker is rigidly attached).
+    fn node_motion(&self, m: MarkerId) -> Option<[V3<T>; 6]> {
+        let shape = self.sys.markers[m].node.as_ref()?;
+        let [eta, etad, etadd] = &self.modal[self.local(self.sys.markers[m].body?)];
+        Some([
+            self.offset(m) + modal_sum(&shape.phi, eta),
+            modal_sum(&shape.phi, etad),
+            modal_sum(&shape.phi, etadd),
+            modal_sum(&shape.rho, eta),
+            modal_sum(&shape.rho, etad),
+            modal_sum(&shape.rho, etadd),
+        ])
     }
 
     /// Evaluate expression `e` whose angle measures use global slots from `angle_base`.
@@ -142,12 +179,21 @@ impl<T: Real> ExprEnv<T> for LocalCtx<'_, T> {
     }
     fn pose(&self, m: MarkerId) -> Pose<T> {
         let g = &self.sys.markers[m];
+        if let (Some(b), Some([p, _, _, th, _, _])) = (self.marker_body(m), self.node_motion(m)) {
+            // The node turns by the small rotation θ: axes (I + θ×) · marker axes.
+            let o = T::one();
+            let turn = M3([[o, -th.0[2], th.0[1]], [th.0[2], o, -th.0[0]], [-th.0[1], th.0[0], o]]);
+            return Pose { p: b.r + b.a.mv(&p), r: b.a.mm(&turn).mm(&M3::cst(&g.rot)) };
+        }
         match self.marker_body(m) {
             None => Pose { p: V3::cst(g.s), r: M3::cst(&g.rot) },
             Some(b) => Pose { p: b.r + b.a.mv(&self.offset(m)), r: b.a.mm(&M3::cst(&g.rot)) },
         }
     }
     fn twist(&self, m: MarkerId) -> Twist<T> {
+        if let (Some(b), Some([p, pd, _, _, thd, _])) = (self.marker_body(m), self.node_motion(m)) {
+            return Twist { v: b.v + b.a.mv(&(b.w.cross(&p) + pd)), w: b.a.mv(&(b.w + thd)) };
+        }
         match self.marker_body(m) {
             None => Twist { v: V3::zero(), w: V3::zero() },
             Some(b) => {
@@ -157,6 +203,13 @@ impl<T: Real> ExprEnv<T> for LocalCtx<'_, T> {
         }
     }
     fn accel(&self, m: MarkerId) -> Twist<T> {
+        if let (Some(b), Some([p, pd, pdd, _, thd, thdd])) = (self.marker_body(m), self.node_motion(m)) {
+            // Given accelerations only: forces and user rows do not read a flexible
+            // body's accelerations (refused when the system is built).
+            let two = T::cst(2.0);
+            let rel = b.wdot.cross(&p) + b.w.cross(&b.w.cross(&p)) + b.w.cross(&pd).mul_s(two) + pdd;
+            return Twist { v: b.acc + b.a.mv(&rel), w: b.a.mv(&(b.wdot + thdd + b.w.cross(&thd))) };
+        }
         match self.marker_body(m) {
             None => Twist { v: V3::zero(), w: V3::zero() },
             Some(b) => {

@@ -33,6 +33,7 @@ pub mod components;
 pub mod constraint_equations;
 pub mod constraint_jacobian;
 pub mod constraints;
+pub mod coords;
 pub mod external;
 pub mod external_values;
 pub mod flexible;

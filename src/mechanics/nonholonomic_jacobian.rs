@@ -13,8 +13,8 @@ pub fn nonholonomic_gamma(sys: &System, q: &[f64], u: &[f64], t: f64, ext: &[f64
     let mut gamma = vec![0.0; sys.mn];
     for el in &sys.nonholonomic {
         let s = nonholonomic_second(sys, el, q, u, t, ext);
-        let nql = NQ * el.bodies.len();
-        let (ql, ul) = (gather(&el.bodies, q), gather(&el.bodies, u));
+        let nql = crate::mechanics::coords::nql(sys, &el.bodies);
+        let (ql, ul) = (gather(sys, &el.bodies, q), gather(sys, &el.bodies, u));
         let mut qd = vec![0.0; nql];
         for kb in 0..el.bodies.len() {
             let r = NQ * kb..NQ * kb + NQ;
@@ -34,11 +34,11 @@ pub fn nonholonomic_b(sys: &System, q: &[f64], u: &[f64], t: f64, ext: &[f64]) -
     let mut g = vec![0.0; sys.mn];
     for el in &sys.nonholonomic {
         let s = nonholonomic_second(sys, el, q, u, t, ext);
-        let nql = NQ * el.bodies.len();
+        let nql = crate::mechanics::coords::nql(sys, &el.bodies);
         for e in 0..el.neq {
             g[el.row + e] = s.c[e];
             for a in 0..nql {
-                b.push((el.row + e, global_column(&el.bodies, a), s.grad[e * s.k + nql + a]));
+                b.push((el.row + e, global_column(sys, &el.bodies, a), s.grad[e * s.k + nql + a]));
             }
         }
     }

@@ -24,6 +24,18 @@ pub struct MarkerGeom {
     pub s: [f64; 3],
     /// Rotation (columns = marker axes in body axes, or in ground).
     pub rot: [[f64; 3]; 3],
+    /// On a flexible body: the node's mode shapes, the marker follows its deflection.
+    pub node: Option<NodeShape>,
+}
+
+/// The shapes of every mode at one node of a flexible body (body axes, per unit modal
+/// coordinate): translation φ_k and small rotation ρ_k.
+#[derive(Clone, Debug)]
+pub struct NodeShape {
+    /// Translational shape of each mode.
+    pub phi: Vec<[f64; 3]>,
+    /// Rotational shape of each mode.
+    pub rho: Vec<[f64; 3]>,
 }
 
 /// Mass properties of a body.
@@ -119,6 +131,20 @@ pub struct System {
     pub q_init: Vec<f64>,
     /// Initial velocities from the model file.
     pub u_init: Vec<f64>,
+    /// Flexible bodies (model order); their modal coordinates follow the six of every
+    /// body in q (see [`super::coords`]).
+    pub flex: Vec<FlexBody>,
+}
+
+/// A modal flexible body of the system.
+#[derive(Clone, Debug)]
+pub struct FlexBody {
+    /// Its body index.
+    pub body: usize,
+    /// Where its modal coordinates η sit in q (and η̇ in u).
+    pub eta: std::ops::Range<usize>,
+    /// Its inertia invariants, stiffness and damping.
+    pub inv: crate::modal::invariants::Invariants,
 }
 
 /// Where an element named in an expression (`fx(name)` ...) lives in the system.
@@ -149,8 +175,24 @@ impl System {
         self.bodies.len()
     }
 
-    /// Number of coordinates n (= number of velocities).
+    /// Number of coordinates n (= number of velocities): six per body, then the modal
+    /// coordinates of the flexible bodies.
     pub fn n(&self) -> usize {
-        NQ * self.bodies.len()
+        NQ * self.bodies.len() + self.flex.iter().map(|f| f.eta.len()).sum::<usize>()
+    }
+
+    /// The global velocity indices of body `b`: its six, then its modal ones.
+    pub fn body_dofs(&self, b: usize) -> Vec<usize> {
+        (NQ * b..NQ * b + NQ).chain(self.modal_range(b)).collect()
+    }
+
+    /// The flexible body that body `b` is, if any.
+    pub fn flex_of(&self, b: usize) -> Option<&FlexBody> {
+        self.flex.iter().find(|f| f.body == b)
+    }
+
+    /// Where body `b`'s modal coordinates sit in q (empty for a rigid body).
+    pub fn modal_range(&self, b: usize) -> std::ops::Range<usize> {
+        self.flex.iter().find(|f| f.body == b).map_or(0..0, |f| f.eta.clone())
     }
 }

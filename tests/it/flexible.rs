@@ -144,13 +144,3 @@ fn bad_modal_data_names_the_element_the_file_and_the_entry() {
     let e = load_in(&dir, &model_text("").replace("arm.json", "none.json")).unwrap_err();
     assert!(e.contains(":2:29: flexible_body 'arm': modal data: ") && e.contains("none.json"), "{e}");
 }
-
-/// Until the engine integrates flexible bodies, it refuses them with a clear message
-/// instead of simulating them as rigid.
-#[test]
-fn the_engine_refuses_flexible_bodies_for_now() {
-    let dir = dir_with("engine", DATA);
-    let m = load_in(&dir, &model_text(r#"    <marker name="tip" node="7"/>"#)).unwrap();
-    let e = mbfmu::mechanics::System::from_model(&m).unwrap_err();
-    assert!(e.contains("flexible body 'arm' (line 2)"), "{e}");
-}

@@ -21,6 +21,7 @@ mod dependencies;
 mod elements;
 mod expr_derivatives;
 mod flexible;
+mod flexible_dynamics;
 mod fmi_capi;
 mod fmi_layer;
 mod fmi_sequences;

@@ -12,8 +12,8 @@ use crate::dae::residual::rhs;
 use crate::dae::sparse::{SparseLu, Triplets};
 use crate::mechanics::System;
 use crate::mechanics::constraint_jacobian::{acceleration_rhs, constraint_jacobian};
+use crate::mechanics::mass::body_mass_entries;
 use crate::mechanics::nonholonomic_jacobian::{nonholonomic_b, nonholonomic_gamma};
-use crate::mechanics::{body::NQ, mass::body_mass_entries};
 
 /// Newton iterations before the loop counts as not converging.
 const MAX_ITERATIONS: usize = 50;
@@ -41,9 +41,10 @@ pub fn consistent_accelerations(
     }
     let lay = Layout::of(sys);
     // Start the acceleration unknowns a from the accelerations without the loop.
-    let a0 = lay.acc_range().start - lay.z();
-    for (k, &b) in sys.acc_bodies.iter().enumerate() {
-        z[a0 + NQ * k..a0 + NQ * (k + 1)].copy_from_slice(&udot0[NQ * b..NQ * (b + 1)]);
+    for &b in &sys.acc_bodies {
+        for g in sys.body_dofs(b) {
+            z[lay.acc_row(&sys.acc_bodies, g).expect("an acceleration body") - lay.z()] = udot0[g];
+        }
     }
     let mut y = lay.assemble(q, u, z, &multipliers0);
     let udot = solve_loop(sys, lay, t, inputs, &mut y, udot0)?;
@@ -154,9 +155,11 @@ fn residual_and_jacobian(
         r[i] = -fi;
     }
     for b in 0..sys.nb() {
-        let unit = (NQ * b..NQ * (b + 1)).map(|i| (i, i, 1.0));
-        let block: Vec<(usize, usize, f64)> =
-            if sys.acc_bodies.contains(&b) { unit.collect() } else { body_mass_entries(sys, b, q).collect() };
+        let block: Vec<(usize, usize, f64)> = if sys.acc_bodies.contains(&b) {
+            sys.body_dofs(b).into_iter().map(|i| (i, i, 1.0)).collect()
+        } else {
+            body_mass_entries(sys, b, q)
+        };
         for (row, col, v) in block {
             r[row] += v * udot[col];
             k.push(row, col, v);

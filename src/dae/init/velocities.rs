@@ -37,14 +37,16 @@ pub fn assemble_velocities(sys: &System, q: &[f64], u: &mut [f64], t: f64, input
     }
     for (k, ic) in sys.ic_velocities.iter().enumerate() {
         // Linear in u: residual(u) = a·u − value; a from dual numbers seeded on u.
-        let ql: Vec<Dual<f64, 24>> = gather(&ic.bodies, q).iter().map(|&v| Dual::cst(v)).collect();
-        let ul: Vec<Dual<f64, 24>> = gather(&ic.bodies, u).iter().enumerate().map(|(i, &v)| Dual::var(v, i)).collect();
+        let ql: Vec<Dual<f64, { crate::mechanics::kernels::MAX_LOCAL }>> =
+            gather(sys, &ic.bodies, q).iter().map(|&v| Dual::cst(v)).collect();
+        let ul: Vec<Dual<f64, { crate::mechanics::kernels::MAX_LOCAL }>> =
+            gather(sys, &ic.bodies, u).iter().enumerate().map(|(i, &v)| Dual::var(v, i)).collect();
         let ctx = LocalCtx::new(sys, &ic.bodies, &ql, &ul, &[], Dual::cst(t), inputs);
         let res = ic.eval(&ctx);
         let r = ic0 + k;
         let mut au = 0.0;
         for (a, &d) in res.d.iter().enumerate().take(ul.len()) {
-            let g = global_column(&ic.bodies, a);
+            let g = global_column(sys, &ic.bodies, a);
             kkt.push(r, g, d);
             kkt.push(g, r, d);
             au += d * u[g];

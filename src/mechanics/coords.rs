@@ -1,0 +1,51 @@
+//! The coordinates of the system and of one element, the one place that maps between
+//! them.
+//!
+//! Global q (and u): six per body, [r; ψ θ φ] ([v; ω']), in body order, then the modal
+//! coordinates η (η̇) of each flexible body, in body order ([`System::modal_range`]).
+//! An element touching `bodies` sees its local coordinates in the same pattern: six per
+//! body it touches (in its order), then the modal coordinates of those of them that are
+//! flexible. A rigid element's local block of body k is `6k..6k + 6` either way.
+
+use super::body::NQ;
+use super::system::System;
+use std::ops::Range;
+
+/// Number of local coordinates of an element touching `bodies`.
+pub fn nql(sys: &System, bodies: &[usize]) -> usize {
+    NQ * bodies.len() + bodies.iter().map(|&b| sys.modal_range(b).len()).sum::<usize>()
+}
+
+/// The global column of every local coordinate of an element touching `bodies`.
+pub fn local_columns(sys: &System, bodies: &[usize]) -> Vec<usize> {
+    let mut cols: Vec<usize> = bodies.iter().flat_map(|&b| NQ * b..NQ * b + NQ).collect();
+    cols.extend(bodies.iter().flat_map(|&b| sys.modal_range(b)));
+    cols
+}
+
+/// Global column of local coordinate `a` of an element touching `bodies`.
+pub fn global_column(sys: &System, bodies: &[usize], a: usize) -> usize {
+    if a < NQ * bodies.len() {
+        return NQ * bodies[a / NQ] + a % NQ;
+    }
+    let mut r = a - NQ * bodies.len();
+    for &b in bodies {
+        let m = sys.modal_range(b);
+        if r < m.len() {
+            return m.start + r;
+        }
+        r -= m.len();
+    }
+    panic!("local coordinate {a} beyond the {} of bodies {bodies:?}", nql(sys, bodies))
+}
+
+/// The local coordinates of an element touching `bodies`, gathered from a global vector.
+pub fn gather(sys: &System, bodies: &[usize], x: &[f64]) -> Vec<f64> {
+    local_columns(sys, bodies).into_iter().map(|g| x[g]).collect()
+}
+
+/// Where local body `k`'s modal coordinates sit among an element's local coordinates.
+pub fn local_modal_range(sys: &System, bodies: &[usize], k: usize) -> Range<usize> {
+    let start = NQ * bodies.len() + bodies[..k].iter().map(|&b| sys.modal_range(b).len()).sum::<usize>();
+    start..start + sys.modal_range(bodies[k]).len()
+}
