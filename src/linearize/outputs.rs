@@ -7,11 +7,9 @@
 
 use crate::ad::{Dual, Real};
 use crate::mechanics::System;
-use crate::mechanics::body::NQ;
-use crate::mechanics::kernels::gather;
+use crate::mechanics::coords::{gather, local_columns, nql};
 use crate::mechanics::loads::{LoadTerm, NLOAD, load_gradient, load_index, load_value};
 use crate::mechanics::local::LocalCtx;
-use crate::model::MAX_ELEMENT_BODIES;
 use crate::model::expr::{ElementRef, Expr, LoadFn, deps};
 use std::ops::Range;
 
@@ -52,6 +50,9 @@ pub struct Point<'a> {
     pub inputs: &'a [f64],
 }
 
+/// Local coordinates seeded at once by [`own_gradient`]: those of four rigid bodies.
+const SEEDED: usize = 24;
+
 /// The gradient of output expression `e` (angle slots from `abase`) at `p`.
 pub fn output_gradient(sys: &System, e: &Expr, abase: usize, p: Point) -> OutputGradient {
     let d = deps(e);
@@ -89,15 +90,16 @@ pub fn output_gradient(sys: &System, e: &Expr, abase: usize, p: Point) -> Output
     }
     bodies.sort_unstable();
     bodies.dedup();
-    let nql = NQ * bodies.len();
-    let slot = |b: usize| bodies.iter().position(|&x| x == b).expect("listed body");
+    let cols = local_columns(sys, &bodies);
+    let nql = cols.len();
+    let position: std::collections::HashMap<usize, usize> = cols.iter().enumerate().map(|(i, &g)| (g, i)).collect();
+    let local = |g: usize| position[&g];
     let mut dz = vec![0.0; 3 * nql];
-    let n_own = NQ * own.len();
+    let own_cols = local_columns(sys, &own);
+    let n_own = own_cols.len();
     for lvl in 0..3 {
-        for (k, &b) in own.iter().enumerate() {
-            for c in 0..NQ {
-                dz[lvl * nql + NQ * slot(b) + c] += dz_own[lvl * n_own + NQ * k + c];
-            }
+        for (k, &g) in own_cols.iter().enumerate() {
+            dz[lvl * nql + local(g)] += dz_own[lvl * n_own + k];
         }
     }
     let mut dlam = Vec::new();
@@ -108,7 +110,6 @@ pub fn output_gradient(sys: &System, e: &Expr, abase: usize, p: Point) -> Output
             continue;
         };
         let dy = load_sensitivity(sys, e, abase, &own, p, &value_of, r);
-        let local = |i: usize| NQ * slot(i / NQ) + i % NQ;
         for (c, &w) in dy.iter().enumerate().filter(|(_, w)| **w != 0.0) {
             // Chain rule: dy = Σ_c ∂y/∂load_c (∂load_c/∂q dq + ∂load_c/∂u du + ∂load_c/∂λ dλ + ∂load_c/∂v dv).
             g.terms(c, |term, d| match term {
@@ -119,7 +120,6 @@ pub fn output_gradient(sys: &System, e: &Expr, abase: usize, p: Point) -> Output
             });
         }
     }
-    let cols = crate::mechanics::coords::local_columns(sys, &bodies);
     OutputGradient { bodies, cols, dz, dlam, dv }
 }
 
@@ -145,10 +145,11 @@ fn load_sensitivity(
     ctx.eval_expr(e, abase).d
 }
 
-/// ∂y/∂(local q, u, u̇) of the output's own kinematic measures (q of every body of `own`,
-/// then u, then u̇), loads held constant. An output may measure any number of bodies:
-/// they are seeded [`MAX_ELEMENT_BODIES`] at a time (the widest dual number), the others
-/// held constant.
+/// ∂y/∂(local q, u, u̇) of the output's own kinematic measures (the local coordinates of
+/// `own`, then their velocities, then their accelerations), loads held constant. An output
+/// may measure any number of bodies: their local coordinates are seeded
+/// [`SEEDED`] at a time (the widest dual number holds their q, u and u̇), the others held
+/// constant.
 fn own_gradient(
     sys: &System,
     e: &Expr,
@@ -157,27 +158,27 @@ fn own_gradient(
     p: Point,
     value_of: &dyn Fn(LoadFn, ElementRef) -> f64,
 ) -> Vec<f64> {
-    let n_own = NQ * own.len();
+    let n_own = nql(sys, own);
     let mut dz = vec![0.0; 3 * n_own];
-    for start in (0..own.len()).step_by(MAX_ELEMENT_BODIES) {
-        let seeded = start..own.len().min(start + MAX_ELEMENT_BODIES);
+    for start in (0..n_own).step_by(SEEDED) {
+        let seeded = start..n_own.min(start + SEEDED);
         let g = match seeded.len() {
-            1 => grad_k::<18>(sys, e, abase, own, seeded.clone(), p, value_of),
-            2 => grad_k::<36>(sys, e, abase, own, seeded.clone(), p, value_of),
-            3 => grad_k::<54>(sys, e, abase, own, seeded.clone(), p, value_of),
+            1..=6 => grad_k::<18>(sys, e, abase, own, seeded.clone(), p, value_of),
+            7..=12 => grad_k::<36>(sys, e, abase, own, seeded.clone(), p, value_of),
+            13..=18 => grad_k::<54>(sys, e, abase, own, seeded.clone(), p, value_of),
             _ => grad_k::<72>(sys, e, abase, own, seeded.clone(), p, value_of),
         };
-        let nc = NQ * seeded.len();
+        let nc = seeded.len();
         for lvl in 0..3 {
-            let (to, from) = (lvl * n_own + NQ * seeded.start, lvl * nc);
+            let (to, from) = (lvl * n_own + seeded.start, lvl * nc);
             dz[to..to + nc].copy_from_slice(&g[from..from + nc]);
         }
     }
     dz
 }
 
-/// ∂y/∂(q, u, u̇ of the bodies `own[seeded]`), the other bodies held constant: q of the
-/// seeded bodies, then u, then u̇ (K ≥ 18 per seeded body).
+/// ∂y/∂(q, u, u̇ of the local coordinates `seeded` of `own`), the others held constant:
+/// q of the seeded coordinates, then u, then u̇ (K ≥ 3 per seeded coordinate).
 fn grad_k<const K: usize>(
     sys: &System,
     e: &Expr,
@@ -187,8 +188,8 @@ fn grad_k<const K: usize>(
     p: Point,
     value_of: &dyn Fn(LoadFn, ElementRef) -> f64,
 ) -> Vec<f64> {
-    let nc = NQ * seeded.len();
-    let first = NQ * seeded.start..NQ * seeded.end;
+    let nc = seeded.len();
+    let first = seeded;
     let seed = |x: Vec<f64>, off: usize| -> Vec<Dual<f64, K>> {
         let var =
             |i: usize, v: f64| if first.contains(&i) { Dual::var(v, off + i - first.start) } else { Dual::cst(v) };

@@ -91,7 +91,7 @@ pub fn select_states_among(
             }
             continue;
         }
-        tiers[c.tier].push(gradient_row(c.state.bodies(), &g.dg));
+        tiers[c.tier].push(gradient_row(sys, c.state.bodies(), &g.dg));
         of_tier[c.tier].push(cands.len());
         cands.push(c);
     }

@@ -84,7 +84,7 @@ pub fn select_velocities(
     for (i, Candidate { state: s, tier, user }) in pos.iter().enumerate() {
         // d/dt s(q) = s_q q̇: the position gradient is the q̇-row.
         let j = &jets(sys, s, q, u, &zeros, t, ext)[0];
-        let row = gradient_row(&s.bodies, &j.dg);
+        let row = gradient_row(sys, &s.bodies, &j.dg);
         push(tier + 1, VelState::Derivative(s.clone()), VelOrigin::Candidate(i), *user, row)?;
     }
     let (mut fixed, mut nf) = constraint_rows(sys, q, t, ext);

@@ -147,6 +147,11 @@ pub enum StateKind {
         /// 0, 1, 2: x, y, z.
         k: usize,
     },
+    /// Modal coordinate k of a flexible body.
+    Modal {
+        /// 0-based mode index.
+        k: usize,
+    },
     /// 3-1-3 angle k (ψ, θ, φ) of a body relative to the fixed frame `r0`.
     Angle {
         /// 0, 1, 2: ψ, θ, φ.
@@ -178,6 +183,7 @@ impl PositionFn for StateFn {
         out[0] = match &self.kind {
             StateKind::User { f, abase } | StateKind::Joint { f, abase, .. } => ctx.eval_expr(f, *abase),
             StateKind::Position { k } => ctx.bodies[0].r.0[*k],
+            StateKind::Modal { k } => ctx.modal_coordinate(0, *k),
             StateKind::Angle { k, r0 } => euler313_from_matrix(&M3::cst(r0).t().mm(&ctx.bodies[0].a))[*k],
         };
     }
@@ -208,6 +214,11 @@ pub fn joint_states(sys: &System) -> Vec<StateFn> {
 /// The internal candidate for coordinate q[i]: `body.x|y|z|psi|theta|phi`, angles relative
 /// to the body's current reference frame.
 pub fn internal_state(sys: &System, i: usize) -> StateFn {
+    if let Some(f) = sys.flex.iter().find(|f| f.eta.contains(&i)) {
+        let k = i - f.eta.start;
+        let name = format!("{}.eta{}", sys.bodies[f.body].name, k + 1);
+        return StateFn { name, kind: StateKind::Modal { k }, bodies: vec![f.body] };
+    }
     let (b, k) = (i / 6, i % 6);
     let names = ["x", "y", "z", "psi", "theta", "phi"];
     let kind = if k < 3 { StateKind::Position { k } } else { StateKind::Angle { k: k - 3, r0: sys.r0[b] } };
@@ -221,6 +232,7 @@ impl StateFn {
         match &self.kind {
             StateKind::Position { .. } => Some("m".into()),
             StateKind::Angle { .. } => Some("rad".into()),
+            StateKind::Modal { .. } => None,
             StateKind::User { f, .. } | StateKind::Joint { f, .. } => {
                 crate::model::units::of_expr(f).map(str::to_string)
             }
@@ -235,6 +247,13 @@ impl StateFn {
             StateKind::Position { .. } => {
                 let (b, c) = self.name.rsplit_once('.').unwrap_or((&self.name, ""));
                 format!("{c} of body '{b}' CM, ground frame")
+            }
+            StateKind::Modal { k } => {
+                let (b, _) = self.name.rsplit_once('.').unwrap_or((&self.name, ""));
+                format!(
+                    "modal coordinate of mode {} of flexible body '{b}' (mode shapes of its modal data file)",
+                    k + 1
+                )
             }
             StateKind::Angle { .. } => {
                 let (b, c) = self.name.rsplit_once('.').unwrap_or((&self.name, ""));

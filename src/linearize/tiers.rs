@@ -10,7 +10,6 @@
 
 use crate::dae::rank::full_pivot;
 use crate::mechanics::System;
-use crate::mechanics::body::NQ;
 use crate::mechanics::constraint_jacobian::{IndependentRows, constraint_jacobian};
 
 /// Weight W of candidate rows relative to constraint rows (Eq. 33's row weighting).
@@ -27,9 +26,9 @@ pub struct CandidateRow {
 
 /// The gradient `dg` of a function of `bodies` (NQ entries per body, local order) as a
 /// candidate row over the global coordinates.
-pub fn gradient_row(bodies: &[usize], dg: &[f64]) -> CandidateRow {
-    let entries = bodies.iter().enumerate().flat_map(|(a, &b)| (0..NQ).map(move |c| (NQ * b + c, dg[NQ * a + c])));
-    CandidateRow { entries: entries.collect() }
+pub fn gradient_row(sys: &System, bodies: &[usize], dg: &[f64]) -> CandidateRow {
+    let cols = crate::mechanics::coords::local_columns(sys, bodies);
+    CandidateRow { entries: cols.into_iter().zip(dg).map(|(g, &v)| (g, v)).collect() }
 }
 
 /// The independent (non-redundant) rows of C_q at (q, t) as (row, col, value), and their

@@ -113,6 +113,11 @@ impl<'a, T: Real> LocalCtx<'a, T> {
         }
     }
 
+    /// Modal coordinate `k` of local body `local` (a flexible body).
+    pub fn modal_coordinate(&self, local: usize, k: usize) -> T {
+        self.modal[local][0][k]
+    }
+
     /// A node marker's body-frame offset p = s + Φt η, rotation θ = Φr η and their first
     /// and second rates (None: the marker is rigidly attached).
     fn node_motion(&self, m: MarkerId) -> Option<[V3<T>; 6]> {

@@ -121,3 +121,43 @@ fn a_tumbling_free_beam_conserves_momenta_and_energy() {
     assert!(worst[0] < 1e-8 && worst[1] < 1e-8 && worst[2] < 1e-8, "{worst:?}");
     assert!(worst[3] < 1e-12, "{worst:?}");
 }
+
+/// A cantilever: the beam's modes computed with node 0 clamped, the body fixed to ground
+/// at node 0. Linearized at rest, the states are the modal coordinates and the
+/// eigenvalues of A are ±i 2π f_k of the data's frequencies to 1e-10 (relative): the
+/// modes are mass-normalized to rounding, so M_ηη = I and K = diag((2πf)²) up to 1e-14.
+#[test]
+fn a_cantilever_linearizes_to_its_modal_frequencies() {
+    let data = soft_beam(3, Some(0));
+    let dir = dir_with("cantilever", &data);
+    let m = load(
+        &dir,
+        r#"<multibody name="cantilever" version="1">
+  <ground><marker name="wall" position="0.5 0 1" euler313="0.2 0.3 0.1"/></ground>
+  <flexible_body name="beam" modal="beam.json" position="0.5 0 1" euler313="0.2 0.3 0.1">
+    <marker name="root" node="0"/>
+  </flexible_body>
+  <joint name="clamp" type="fixed" i="beam.root" j="ground.wall"/>
+</multibody>
+"#,
+    );
+    let lin = crate::common::lin_at_start(&m);
+    assert_eq!(
+        lin.states,
+        ["beam.eta1", "beam.eta2", "beam.eta3", "der(beam.eta1)", "der(beam.eta2)", "der(beam.eta3)"]
+    );
+    let mut im: Vec<f64> = lin.a.eigenvalues().unwrap().iter().filter(|z| z.im > 0.0).map(|z| z.im).collect();
+    im.sort_by(f64::total_cmp);
+    let mbfmu::modal::ModalStiffness::Frequencies(f) = &data.stiffness else { panic!("frequencies") };
+    assert_eq!(im.len(), 3);
+    let mut worst = 0.0f64;
+    for (w, f) in im.iter().zip(f) {
+        let exact = 2.0 * std::f64::consts::PI * f;
+        worst = worst.max((w - exact).abs() / exact);
+        assert!((w - exact).abs() < 1e-10 * exact, "ω = {w} vs 2πf = {exact}");
+    }
+    eprintln!("cantilever: frequencies {f:?} Hz, max relative eigenvalue error {worst:e}");
+    for z in lin.a.eigenvalues().unwrap().iter() {
+        assert!(z.re.abs() < 1e-10 * z.im.abs().max(1.0), "undamped: {z:?}");
+    }
+}

@@ -11,7 +11,7 @@ use mbfmu::dae::{SimOptions, Simulator};
 use mbfmu::linearize::jets::{PositionFn, jets};
 use mbfmu::linearize::{Linearization, Selection, linearize, select_states};
 use mbfmu::mechanics::System;
-use mbfmu::mechanics::body::NQ;
+use mbfmu::mechanics::coords::local_columns;
 use mbfmu::mechanics::loads::{load_index, load_value};
 use mbfmu::mechanics::local::LocalCtx;
 use mbfmu::model::Model;
@@ -94,9 +94,10 @@ pub fn state_space(sys: &System, sel: &Selection, q0: &[f64], t: f64, x: &[f64],
                 let row = el.row + e;
                 r[row] = if level == 0 { j.g } else { j.g1 };
                 let g = if level == 0 { &j.dg } else { &j.dg1 };
-                let nql = NQ * el.bodies().len();
-                for a in 0..nql {
-                    mat[row * n + NQ * el.bodies()[a / NQ] + a % NQ] += g[if level == 0 { a } else { nql + a }];
+                let cols = local_columns(sys, el.bodies());
+                let nql = cols.len();
+                for (a, &c) in cols.iter().enumerate() {
+                    mat[row * n + c] += g[if level == 0 { a } else { nql + a }];
                 }
             }
         }
@@ -104,9 +105,10 @@ pub fn state_space(sys: &System, sel: &Selection, q0: &[f64], t: f64, x: &[f64],
             let j = &jets(sys, st, q, u, &zeros, t, v)[0];
             r[m + k] = if level == 0 { j.g - x[k] } else { j.g1 - x[s + k] };
             let g = if level == 0 { &j.dg } else { &j.dg1 };
-            let nql = NQ * st.bodies().len();
-            for a in 0..nql {
-                mat[(m + k) * n + NQ * st.bodies()[a / NQ] + a % NQ] += g[if level == 0 { a } else { nql + a }];
+            let cols = local_columns(sys, st.bodies());
+            let nql = cols.len();
+            for (a, &c) in cols.iter().enumerate() {
+                mat[(m + k) * n + c] += g[if level == 0 { a } else { nql + a }];
             }
         }
         (mat, r)
