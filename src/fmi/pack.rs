@@ -168,13 +168,50 @@ fn contents(model_path: &Path) -> Result<Contents, PackError> {
         .iter()
         .map(|why| format!("the FMU has no linearization states (fmi2GetDirectionalDerivative will fail): {why}"))
         .collect();
-    let files = vec![
+    let mut files = vec![
         ("modelDescription.xml".to_string(), xml.into_bytes()),
         (format!("binaries/{PLATFORM}/{id}.{LIB_EXT}"), lib),
         ("resources/model.xml".to_string(), bytes.clone()),
         (format!("resources/{LAYOUT_FILE}"), layout.to_text(&guid).into_bytes()),
     ];
+    files.extend(modal_files(&model)?);
     Ok(Contents { packed: Packed { guid, model_identifier: id, warnings }, files })
+}
+
+/// The modal data files of the model's flexible bodies, as `resources/<path as written>`
+/// (the FMU reads `resources/model.xml`, whose relative paths then point there). A path
+/// that is absolute or leaves the model's directory cannot be packed.
+fn modal_files(model: &crate::model::Model) -> Result<Vec<(String, Vec<u8>)>, PackError> {
+    let mut out: Vec<(String, Vec<u8>)> = Vec::new();
+    for b in &model.bodies {
+        let Some(f) = &b.flex else { continue };
+        let err = |msg: String| ModelError {
+            file: model.file.clone(),
+            pos: b.pos,
+            element: "flexible_body".into(),
+            name: b.name.clone(),
+            msg,
+        };
+        let rel = Path::new(&f.file);
+        let inside =
+            rel.components().all(|c| matches!(c, std::path::Component::Normal(_) | std::path::Component::CurDir));
+        if !inside {
+            return Err(err(format!(
+                "modal data '{}': to be packed into the FMU it must be a relative path inside the model file's directory",
+                f.file
+            ))
+            .into());
+        }
+        let data = std::fs::read(&f.path).map_err(|e| err(format!("modal data '{}': cannot read: {e}", f.path)))?;
+        let name = format!(
+            "resources/{}",
+            rel.components().filter_map(|c| c.as_os_str().to_str()).filter(|c| *c != ".").collect::<Vec<_>>().join("/")
+        );
+        if !out.iter().any(|(n, _)| *n == name) {
+            out.push((name, data));
+        }
+    }
+    Ok(out)
 }
 
 /// The state layout file of the model text `model_text` (as [`pack`] writes it into

@@ -157,8 +157,9 @@ fn unescape(s: &str) -> Option<String> {
     Some(out)
 }
 
-/// A position state by name: a user state, a joint coordinate (`joint.angle` ...), or
-/// `body.x|y|z|psi|theta|phi` (the angles relative to the body's reference frame).
+/// A position state by name: a user state, a joint coordinate (`joint.angle` ...),
+/// `body.x|y|z|psi|theta|phi` (the angles relative to the body's reference frame), or a
+/// flexible body's modal coordinate `body.etaK`.
 fn position_by_name(sys: &System, name: &str) -> Result<StateFn, String> {
     if let Some(s) = user_states(sys).into_iter().chain(joint_states(sys)).find(|u| u.name == name) {
         return Ok(s);
@@ -167,6 +168,14 @@ fn position_by_name(sys: &System, name: &str) -> Result<StateFn, String> {
     let unknown = || format!("unknown linearization state '{name}'");
     let (body, c) = name.rsplit_once('.').ok_or_else(unknown)?;
     let b = sys.bodies.iter().position(|x| x.name == body);
+    // A flexible body's modal coordinate `body.etaK` (K from 1).
+    if let (Some(b), Some(k)) = (b, c.strip_prefix("eta").and_then(|k| k.parse::<usize>().ok())) {
+        let m = sys.modal_range(b);
+        return match k {
+            1.. if k <= m.len() => Ok(internal_state(sys, m.start + k - 1)),
+            _ => Err(unknown()),
+        };
+    }
     let k = coord.iter().position(|x| *x == c);
     match (b, k) {
         (Some(b), Some(k)) => Ok(internal_state(sys, 6 * b + k)),

@@ -20,16 +20,22 @@ use std::collections::BTreeMap;
 /// Sparse entries of a dense row.
 /// A sparse u-space row (global columns, any order, repeated columns summed) as the same
 /// linear form in q̇ (times T(q)): sorted by column, zeros left out.
-fn qdot_row(q: &[f64], entries: impl IntoIterator<Item = (usize, f64)>) -> Vec<(usize, f64)> {
+fn qdot_row(sys: &System, q: &[f64], entries: impl IntoIterator<Item = (usize, f64)>) -> Vec<(usize, f64)> {
+    let body_cols = NQ * sys.nb();
     let mut by_body: BTreeMap<usize, [f64; NQ]> = BTreeMap::new();
+    let mut modal: BTreeMap<usize, f64> = BTreeMap::new(); // T = I for modal velocities
     for (c, v) in entries {
-        by_body.entry(c / NQ).or_insert([0.0; NQ])[c % NQ] += v;
+        if c >= body_cols {
+            *modal.entry(c).or_insert(0.0) += v;
+        } else {
+            by_body.entry(c / NQ).or_insert([0.0; NQ])[c % NQ] += v;
+        }
     }
     let blocks = by_body.into_iter().flat_map(|(b, mut r)| {
         block_times_t(&q[NQ * b..NQ * (b + 1)], &mut r);
         (0..NQ).map(move |c| (NQ * b + c, r[c]))
     });
-    blocks.filter(|&(_, v)| v != 0.0).collect()
+    blocks.chain(modal).filter(|&(_, v)| v != 0.0).collect()
 }
 
 /// Where a velocity candidate comes from (the index relation to the position level).
@@ -78,7 +84,7 @@ pub fn select_velocities(
     for (k, v) in user_velocities(sys).into_iter().enumerate() {
         let j = &jets(sys, &v, q, u, &zeros, t, ext)[0];
         let nql = nql(sys, &v.bodies);
-        let row = qdot_row(q, (0..nql).map(|a| (global_column(sys, &v.bodies, a), j.dg[nql + a])));
+        let row = qdot_row(sys, q, (0..nql).map(|a| (global_column(sys, &v.bodies, a), j.dg[nql + a])));
         push(0, VelState::User(v), VelOrigin::User(k), true, CandidateRow { entries: row })?;
     }
     for (i, Candidate { state: s, tier, user }) in pos.iter().enumerate() {
@@ -94,7 +100,7 @@ pub fn select_velocities(
         brows[r].push((c, v));
     }
     for row in brows {
-        fixed.extend(qdot_row(q, row).into_iter().map(|(c, v)| (nf, c, v)));
+        fixed.extend(qdot_row(sys, q, row).into_iter().map(|(c, v)| (nf, c, v)));
         nf += 1;
     }
     // Sparse complete pivoting (as at position level); the (independent) holonomic rows

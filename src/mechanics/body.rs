@@ -43,10 +43,11 @@ pub fn h_transpose_times<T: Real>(q: &[T], w: &[T]) -> [T; NQ] {
     [w[0], w[1], w[2], e.0[0], e.0[1], e.0[2]]
 }
 
-/// A u-space row `r` (global, 6 per body) times T(q), with u = T(q) q̇: the same linear
-/// form in q̇ (T = H⁻¹ per body; T_angular maps 3-1-3 rates to body-axis ω').
-pub fn row_times_t(q: &[f64], r: &mut [f64]) {
-    for b in 0..q.len() / NQ {
+/// A u-space row `r` (global: 6 per body for `nb` bodies, then modal entries, which T
+/// leaves alone) times T(q), with u = T(q) q̇: the same linear form in q̇ (T = H⁻¹ per
+/// body; T_angular maps 3-1-3 rates to body-axis ω').
+pub fn row_times_t(nb: usize, q: &[f64], r: &mut [f64]) {
+    for b in 0..nb {
         let o = NQ * b;
         block_times_t(&q[o..o + NQ], &mut r[o..o + NQ]);
     }

@@ -22,6 +22,7 @@ mod elements;
 mod expr_derivatives;
 mod flexible;
 mod flexible_dynamics;
+mod flexible_fmu;
 mod fmi_capi;
 mod fmi_layer;
 mod fmi_sequences;

@@ -49,7 +49,7 @@ fn held_directions(sys: &System, q: &[f64], t: f64, ext: &[f64]) -> Vec<Vec<f64>
     for (r, c, v) in nonholonomic_b(sys, q, &vec![0.0; n], t, ext).0 {
         bt[r][c] += v;
     }
-    bt.iter_mut().for_each(|row| row_times_t(q, row));
+    bt.iter_mut().for_each(|row| row_times_t(sys.nb(), q, row));
     bt
 }
 

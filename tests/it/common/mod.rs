@@ -11,6 +11,7 @@ use mbfmu::dae::{SimOptions, Simulator};
 use mbfmu::linearize::jets::{PositionFn, jets};
 use mbfmu::linearize::{Linearization, Selection, linearize, select_states};
 use mbfmu::mechanics::System;
+use mbfmu::mechanics::constraint_jacobian::IndependentRows;
 use mbfmu::mechanics::coords::local_columns;
 use mbfmu::mechanics::loads::{load_index, load_value};
 use mbfmu::mechanics::local::LocalCtx;
@@ -81,7 +82,9 @@ pub fn lin_at_start(m: &Model) -> Linearization {
 /// differential states only (user variables are solved, not states).
 /// Central differences of this map are the tests' independent reference for A, B, C, D.
 pub fn state_space(sys: &System, sel: &Selection, q0: &[f64], t: f64, x: &[f64], v: &[f64]) -> (Vec<f64>, Vec<f64>) {
-    let (n, m, s) = (sys.n(), sys.m, sel.states.len());
+    // Constraint rows found redundant at initialization are left out (their λ = 0).
+    let rows = IndependentRows::of(sys);
+    let (n, m, s) = (sys.n(), rows.count, sel.states.len());
     let zeros = vec![0.0; n];
     let mut q = q0.to_vec();
     let square = |q: &[f64], u: &[f64], level: usize| -> (Vec<f64>, Vec<f64>) {
@@ -91,7 +94,7 @@ pub fn state_space(sys: &System, sel: &Selection, q0: &[f64], t: f64, x: &[f64],
         for el in &sys.constraints {
             let js = jets(sys, el, q, u, &zeros, t, v);
             for (e, j) in js.iter().enumerate() {
-                let row = el.row + e;
+                let Some(row) = rows.of_row[el.row + e] else { continue };
                 r[row] = if level == 0 { j.g } else { j.g1 };
                 let g = if level == 0 { &j.dg } else { &j.dg1 };
                 let cols = local_columns(sys, el.bodies());
