@@ -116,33 +116,30 @@ impl<'a> Loader<'a> {
         el.req("inertia")?;
         let inertia = el.num_vec("inertia", &[3, 6])?.unwrap_or(NumVec { items: vec![] });
         check_inertia(&inertia.values()).map_err(|m| el.err_at(el.get("inertia").map_or(x.pos, |a| a.pos), m))?;
-        let body = Body {
-            name: x.label().into(),
-            mass,
-            inertia,
-            position: el.vec3_req("position")?,
-            orientation: read_orientation(&el)?,
-            velocity: el.num_vec("velocity", &[3])?,
-            angular_velocity: el.num_vec("angular_velocity", &[3])?,
-            flex: None,
-            pos: x.pos,
-        };
-        let idx = self.model.bodies.len();
+        let body = body_with(&el, x, mass, inertia)?;
         let name = body.name.clone();
-        self.model.bodies.push(body);
-        self.model.markers.push(Marker {
-            name: format!("{name}.cm"),
-            body: Some(idx),
-            position: NumVec { items: vec![constant(0.0), constant(0.0), constant(0.0)] },
-            orientation: Orientation::Identity,
-            node: None,
-            pos: x.pos,
-        });
+        let idx = self.push_body(body, [0.0; 3]);
         for m in &x.children {
             let mk = self.marker(m, &name, Some(idx))?;
             self.model.markers.push(mk);
         }
         Ok(())
+    }
+
+    /// Add `body` and its implicit `cm` marker at `cm` (body frame); its index.
+    pub(super) fn push_body(&mut self, body: Body, cm: [f64; 3]) -> usize {
+        let idx = self.model.bodies.len();
+        let (name, pos) = (body.name.clone(), body.pos);
+        self.model.bodies.push(body);
+        self.model.markers.push(Marker {
+            name: format!("{name}.cm"),
+            body: Some(idx),
+            position: NumVec { items: cm.map(constant).to_vec() },
+            orientation: Orientation::Identity,
+            node: None,
+            pos,
+        });
+        idx
     }
 
     /// A `<marker>` of `owner` (a body's name, or "ground"), on `body`.
@@ -176,6 +173,22 @@ impl<'a> Loader<'a> {
         self.model.static_analysis = b.unwrap_or(false);
         Ok(())
     }
+}
+
+/// A body element `x` with mass properties `mass`, `inertia`: its frame and initial
+/// velocities from the attributes `<body>` and `<flexible_body>` share.
+pub(super) fn body_with(el: &El, x: &XElem, mass: Num, inertia: NumVec) -> Result<Body, ModelError> {
+    Ok(Body {
+        name: x.label().into(),
+        mass,
+        inertia,
+        position: el.vec3_req("position")?,
+        orientation: read_orientation(el)?,
+        velocity: el.num_vec("velocity", &[3])?,
+        angular_velocity: el.num_vec("angular_velocity", &[3])?,
+        flex: None,
+        pos: x.pos,
+    })
 }
 
 /// A required marker reference.

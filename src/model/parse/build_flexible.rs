@@ -2,6 +2,7 @@
 //! "Flexible bodies"), and its markers, each attached to a node of the data.
 
 use super::attrs::constant;
+use super::build::body_with;
 use super::load::Loader;
 use super::orient::read_orientation;
 use super::xml::XElem;
@@ -21,31 +22,9 @@ impl<'a> Loader<'a> {
         let data = crate::modal::read(Path::new(&path)).map_err(|e| el.err_at(attr.pos, format!("modal data: {e}")))?;
         let (mass, cm, inertia) = rigid_properties(&data);
         let name = x.label().to_string();
-        let body = Body {
-            name: name.clone(),
-            mass: constant(mass),
-            inertia: NumVec {
-                items: [inertia[0][0], inertia[1][1], inertia[2][2], inertia[0][1], inertia[0][2], inertia[1][2]]
-                    .map(constant)
-                    .to_vec(),
-            },
-            position: el.vec3_req("position")?,
-            orientation: read_orientation(&el)?,
-            velocity: el.num_vec("velocity", &[3])?,
-            angular_velocity: el.num_vec("angular_velocity", &[3])?,
-            flex: None,
-            pos: x.pos,
-        };
-        let idx = self.model.bodies.len();
-        self.model.bodies.push(body);
-        self.model.markers.push(Marker {
-            name: format!("{name}.cm"),
-            body: Some(idx),
-            position: NumVec { items: cm.map(constant).to_vec() },
-            orientation: Orientation::Identity,
-            node: None,
-            pos: x.pos,
-        });
+        let j = [inertia[0][0], inertia[1][1], inertia[2][2], inertia[0][1], inertia[0][2], inertia[1][2]];
+        let body = body_with(&el, x, constant(mass), NumVec { items: j.map(constant).to_vec() })?;
+        let idx = self.push_body(body, cm);
         for m in &x.children {
             let mk = self.node_marker(m, &name, idx, &data, &path)?;
             self.model.markers.push(mk);
