@@ -534,8 +534,24 @@ fn check_flexible(
     nonholonomic: &[NonholonomicEl],
     user: &[UserEq],
 ) -> Result<(), String> {
+    let lin_exprs: Vec<(&str, Vec<usize>)> = model
+        .lin_states
+        .iter()
+        .map(|s| (s.name.as_str(), &s.function))
+        .chain(model.lin_velocities.iter().map(|v| (v.name.as_str(), &v.function)))
+        .map(|(n, e)| (n, bodies_of(markers, &[], &[e])))
+        .collect();
     if flex.is_empty() {
         return Ok(());
+    }
+    if let Some(f) = flex.iter().find(|f| NQ + f.eta.len() > MAX_LOCAL) {
+        return Err(format!(
+            "flexible body '{}' has {} modes (at most {}: its six coordinates and its modes must fit \
+             the widest dual number, {MAX_LOCAL})",
+            model.bodies[f.body].name,
+            f.eta.len(),
+            MAX_LOCAL - NQ
+        ));
     }
     let count = |bodies: &[usize]| {
         NQ * bodies.len()
@@ -555,7 +571,8 @@ fn check_flexible(
         .flat_map(|cs| cs.iter().map(|c| too_many("constraint", &c.name, &c.bodies)))
         .chain(forces.iter().map(|f| too_many("force", &f.name, &f.bodies)))
         .chain(nonholonomic.iter().map(|c| too_many("constraint", &c.name, &c.bodies)))
-        .chain(user.iter().map(|u| too_many("user element", &u.name, &u.bodies)));
+        .chain(user.iter().map(|u| too_many("user element", &u.name, &u.bodies)))
+        .chain(lin_exprs.iter().map(|(name, bodies)| too_many("linearization state", name, bodies)));
     if let Some(e) = checks.flatten().next() {
         return Err(e);
     }

@@ -233,3 +233,23 @@ fn a_four_bar_with_a_flexible_coupler_matches_central_differences() {
     }
     eprintln!("flexible four-bar: states {:?}, max relative |A − central differences| {worst:e}", lin.states);
 }
+
+/// More modes than the widest dual number holds with the body's six coordinates (30) is
+/// refused when the system is built, with the body named, not a crash later.
+#[test]
+fn a_body_with_too_many_modes_is_refused_with_its_name() {
+    let data = soft_beam(31, None);
+    let dir = dir_with("too-many", &data);
+    let m = load(
+        &dir,
+        r#"<multibody name="big" version="1">
+  <flexible_body name="beam" modal="beam.json" position="0 0 0"/>
+</multibody>
+"#,
+    );
+    let e = mbfmu::mechanics::System::from_model(&m).unwrap_err();
+    assert_eq!(
+        e,
+        "flexible body 'beam' has 31 modes (at most 30: its six coordinates and its modes must fit the widest dual number, 36)"
+    );
+}
