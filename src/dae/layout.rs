@@ -79,11 +79,14 @@ impl Layout {
     pub fn acc(&self) -> usize {
         self.z() + 2 * self.nx + self.nv
     }
-    /// Where in Z (not y) the accelerations of the k-th body with acceleration unknowns
-    /// (`System::acc_bodies[k]`) live: 6 entries, v̇ then ω̇'.
-    pub fn acc_in_z(&self, k: usize) -> Range<usize> {
-        let a0 = 2 * self.nx + self.nv + NQ * k;
-        a0..a0 + NQ
+    /// Copy the accelerations `udot` (n, global) of the bodies with acceleration unknowns
+    /// into their entries of Z (`z`, not y).
+    pub fn set_accelerations(&self, sys: &System, udot: &[f64], z: &mut [f64]) {
+        for &b in &sys.acc_bodies {
+            for g in sys.body_dofs(b) {
+                z[self.acc_row(&sys.acc_bodies, g).expect("an acceleration body") - self.z()] = udot[g];
+            }
+        }
     }
     /// Offset of λ.
     pub fn lam(&self) -> usize {

@@ -155,12 +155,7 @@ impl Simulator {
         let mut z = self.user_values().to_vec();
         // Acceleration unknowns: those of the same solve as λ.
         if let Some((udot, _)) = &self.acc {
-            let sys = &self.dae.sys;
-            for &b in &sys.acc_bodies {
-                for g in sys.body_dofs(b) {
-                    z[lay.acc_row(&sys.acc_bodies, g).expect("an acceleration body") - lay.z()] = udot[g];
-                }
-            }
+            lay.set_accelerations(&self.dae.sys, udot, &mut z);
         }
         self.dae.sys.ext(&self.dae.inputs_at(t), &z, Some(state), t)
     }

@@ -11,7 +11,7 @@ use crate::ad::{Dual, Real};
 use crate::mechanics::System;
 use crate::mechanics::body::{NQ, qdot};
 use crate::mechanics::constraints::ConstraintEl;
-use crate::mechanics::kernels::gather;
+use crate::mechanics::coords::{gather, nql};
 use crate::mechanics::local::LocalCtx;
 
 /// A function of body poses and time, evaluated generically.
@@ -85,7 +85,7 @@ pub fn jets<F: PositionFn>(
     inputs: &[f64],
 ) -> Vec<Jet> {
     // q, u and u̇ of every local coordinate, and t.
-    match 3 * crate::mechanics::coords::nql(sys, f.bodies()) + 1 {
+    match 3 * nql(sys, f.bodies()) + 1 {
         1 => jets_k::<1, F>(sys, f, q, u, udot, t, inputs),
         2..=19 => jets_k::<19, F>(sys, f, q, u, udot, t, inputs),
         20..=37 => jets_k::<37, F>(sys, f, q, u, udot, t, inputs),
@@ -107,7 +107,7 @@ fn jets_k<const K: usize, F: PositionFn>(
 ) -> Vec<Jet> {
     type B<const K: usize> = Dual<f64, K>;
     let bodies = f.bodies();
-    let nq = crate::mechanics::coords::nql(sys, bodies);
+    let nq = nql(sys, bodies);
     let seed =
         |x: Vec<f64>, off: usize| -> Vec<B<K>> { x.iter().enumerate().map(|(i, &v)| B::var(v, off + i)).collect() };
     let qb = seed(gather(sys, bodies, q), 0);

@@ -7,7 +7,8 @@ use super::select::Selection;
 use crate::dae::EngineError;
 use crate::dae::rank::full_pivot;
 use crate::mechanics::System;
-use crate::mechanics::constraint_jacobian::{IndependentRows, constraint_jacobian, global_column};
+use crate::mechanics::constraint_jacobian::{IndependentRows, constraint_jacobian};
+use crate::mechanics::coords::{global_column, nql};
 
 /// The smallest pivot of [C_q; s_q] relative to the largest, below which the states no
 /// longer parameterize the positions.
@@ -24,7 +25,7 @@ pub fn check_partition(sys: &System, sel: &Selection, q: &[f64], t: f64, ext: &[
     for (i, st) in sel.states.iter().enumerate().take(n.saturating_sub(rows.count)) {
         let jet = &jets(sys, st, q, &zeros, &zeros, t, ext)[0];
         let row = rows.count + i;
-        let dq = &jet.dg[..crate::mechanics::coords::nql(sys, &st.bodies)]; // ∂s/∂q (the jet also holds ∂s/∂u)
+        let dq = &jet.dg[..nql(sys, &st.bodies)]; // ∂s/∂q (the jet also holds ∂s/∂u)
         j.extend(dq.iter().enumerate().map(|(a, &v)| (row, global_column(sys, &st.bodies, a), v)));
     }
     // Stops at the first pivot ≤ PARTITION_TOL·largest: then the next candidate is the ratio.

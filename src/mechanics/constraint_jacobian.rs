@@ -8,8 +8,7 @@
 
 use super::body::{NQ, h_transpose_times, qdot};
 use super::constraints::ConstraintEl;
-pub use super::coords::global_column;
-use super::coords::{gather, nql};
+use super::coords::{gather, global_column, nql};
 use super::kernels::{constraint_first, constraint_second, dqdot_dq};
 use super::system::System;
 

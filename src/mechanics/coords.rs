@@ -18,9 +18,13 @@ pub fn nql(sys: &System, bodies: &[usize]) -> usize {
 
 /// The global column of every local coordinate of an element touching `bodies`.
 pub fn local_columns(sys: &System, bodies: &[usize]) -> Vec<usize> {
-    let mut cols: Vec<usize> = bodies.iter().flat_map(|&b| NQ * b..NQ * b + NQ).collect();
-    cols.extend(bodies.iter().flat_map(|&b| sys.modal_range(b)));
-    cols
+    columns(sys, bodies).collect()
+}
+
+/// The global columns of `bodies`' local coordinates, in local order.
+fn columns<'a>(sys: &'a System, bodies: &'a [usize]) -> impl Iterator<Item = usize> + 'a {
+    let rigid = bodies.iter().flat_map(|&b| NQ * b..NQ * b + NQ);
+    rigid.chain(bodies.iter().flat_map(|&b| sys.modal_range(b)))
 }
 
 /// Global column of local coordinate `a` of an element touching `bodies`.
@@ -41,7 +45,7 @@ pub fn global_column(sys: &System, bodies: &[usize], a: usize) -> usize {
 
 /// The local coordinates of an element touching `bodies`, gathered from a global vector.
 pub fn gather(sys: &System, bodies: &[usize], x: &[f64]) -> Vec<f64> {
-    local_columns(sys, bodies).into_iter().map(|g| x[g]).collect()
+    columns(sys, bodies).map(|g| x[g]).collect()
 }
 
 /// Where local body `k`'s modal coordinates sit among an element's local coordinates.

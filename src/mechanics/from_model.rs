@@ -7,6 +7,7 @@
 
 use super::body::{FAR_FROM_SINGULAR, NQ, rebased_reference};
 use super::constraints::{ConstraintEl, ConstraintKind, VelocityIc};
+use super::coords::nql;
 use super::external::ExtLayout;
 use super::forces::{ForceEl, ForceKind};
 use super::joint_coords::{JointCoord, joint_coordinates};
@@ -43,11 +44,10 @@ impl System {
         let forces = forces(model, &markers, &reads, &mut slots);
         let user = user_rows(model, &markers, &ext, &reads, &mut slots);
         check_elements(model, &nonholonomic, &load_refs, &user, &constraints, &forces)?;
-        check_flexible(model, &markers, &flex, &[&constraints, &ic_constraints], &forces, &nonholonomic, &user)?;
         let measures = measures(model, &mut slots);
         let nj = model.joints.len();
         let (nsd, nsf, ngf) = (model.spring_dampers.len(), model.sforces.len(), model.gforces.len());
-        Ok(System {
+        let sys = System {
             params: model.parameters.iter().map(|p| p.value.value).collect(),
             gravity: model.gravity,
             bodies: bodies.props,
@@ -85,7 +85,9 @@ impl System {
             q_init: bodies.q_init,
             u_init: bodies.u_init,
             flex,
-        })
+        };
+        check_flexible(model, &sys)?;
+        Ok(sys)
     }
 }
 
@@ -523,28 +525,13 @@ fn check_elements(
 }
 
 /// Elements touching flexible bodies: at most [`MAX_LOCAL`] local coordinates each (six
-/// per body, plus the modal ones), and no force or user row reads a flexible body's
-/// accelerations.
-fn check_flexible(
-    model: &Model,
-    markers: &[MarkerGeom],
-    flex: &[FlexBody],
-    constraints: &[&[ConstraintEl]],
-    forces: &[ForceEl],
-    nonholonomic: &[NonholonomicEl],
-    user: &[UserEq],
-) -> Result<(), String> {
-    let lin_exprs: Vec<(&str, Vec<usize>)> = model
-        .lin_states
-        .iter()
-        .map(|s| (s.name.as_str(), &s.function))
-        .chain(model.lin_velocities.iter().map(|v| (v.name.as_str(), &v.function)))
-        .map(|(n, e)| (n, bodies_of(markers, &[], &[e])))
-        .collect();
-    if flex.is_empty() {
+/// per body, plus the modal ones; [`nql`]), a flexible body at most `MAX_LOCAL − 6` modes,
+/// and no force or user row reads a flexible body's accelerations.
+fn check_flexible(model: &Model, sys: &System) -> Result<(), String> {
+    if sys.flex.is_empty() {
         return Ok(());
     }
-    if let Some(f) = flex.iter().find(|f| NQ + f.eta.len() > MAX_LOCAL) {
+    if let Some(f) = sys.flex.iter().find(|f| NQ + f.eta.len() > MAX_LOCAL) {
         return Err(format!(
             "flexible body '{}' has {} modes (at most {}: its six coordinates and its modes must fit \
              the widest dual number, {MAX_LOCAL})",
@@ -553,12 +540,8 @@ fn check_flexible(
             MAX_LOCAL - NQ
         ));
     }
-    let count = |bodies: &[usize]| {
-        NQ * bodies.len()
-            + bodies.iter().filter_map(|&b| flex.iter().find(|f| f.body == b)).map(|f| f.eta.len()).sum::<usize>()
-    };
     let too_many = |what: &str, name: &str, bodies: &[usize]| {
-        let n = count(bodies);
+        let n = nql(sys, bodies);
         (n > MAX_LOCAL).then(|| {
             format!(
                 "{what} '{name}' has {n} coordinates (six per body it touches plus the modal ones; at most \
@@ -566,19 +549,27 @@ fn check_flexible(
             )
         })
     };
-    let checks = constraints
+    let lin_exprs: Vec<(&str, Vec<usize>)> = sys
+        .lin_states
         .iter()
-        .flat_map(|cs| cs.iter().map(|c| too_many("constraint", &c.name, &c.bodies)))
-        .chain(forces.iter().map(|f| too_many("force", &f.name, &f.bodies)))
-        .chain(nonholonomic.iter().map(|c| too_many("constraint", &c.name, &c.bodies)))
-        .chain(user.iter().map(|u| too_many("user element", &u.name, &u.bodies)))
+        .chain(&sys.lin_velocities)
+        .map(|(name, e, _)| (name.as_str(), bodies_of(&sys.markers, &[], &[e])))
+        .collect();
+    let checks = sys
+        .constraints
+        .iter()
+        .chain(&sys.ic_constraints)
+        .map(|c| too_many("constraint", &c.name, &c.bodies))
+        .chain(sys.forces.iter().map(|f| too_many("force", &f.name, &f.bodies)))
+        .chain(sys.nonholonomic.iter().map(|c| too_many("constraint", &c.name, &c.bodies)))
+        .chain(sys.user.iter().map(|u| too_many("user element", &u.name, &u.bodies)))
         .chain(lin_exprs.iter().map(|(name, bodies)| too_many("linearization state", name, bodies)));
     if let Some(e) = checks.flatten().next() {
         return Err(e);
     }
     for e in force_and_user_exprs(model) {
         let d = deps(e);
-        let flexible = d.markers.iter().filter_map(|&m| markers[m].body).find(|&b| model.bodies[b].flex.is_some());
+        let flexible = d.markers.iter().filter_map(|&m| sys.markers[m].body).find(|&b| sys.flex_of(b).is_some());
         if let (true, Some(b)) = (d.level >= 2, flexible) {
             return Err(format!(
                 "a force or user element reads accelerations of flexible body '{}', which is not supported",

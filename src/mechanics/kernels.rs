@@ -4,8 +4,7 @@
 
 use super::body::{h_transpose_times, qdot};
 use super::constraints::ConstraintEl;
-pub use super::coords::gather;
-use super::coords::nql;
+use super::coords::{gather, nql};
 use super::forces::ForceEl;
 use super::local::LocalCtx;
 use super::nonholonomic::NonholonomicEl;

@@ -3,8 +3,8 @@
 //! one place for every user.
 
 use super::body::{NQ, qdot};
-use super::constraint_jacobian::global_column;
-use super::kernels::{gather, nonholonomic_second};
+use super::coords::{gather, global_column};
+use super::kernels::nonholonomic_second;
 use super::system::System;
 
 /// γ of the non-holonomic acceleration constraint B u̇ + γ = 0: ġ at u̇ = 0, i.e.

@@ -41,11 +41,7 @@ pub fn consistent_accelerations(
     }
     let lay = Layout::of(sys);
     // Start the acceleration unknowns a from the accelerations without the loop.
-    for &b in &sys.acc_bodies {
-        for g in sys.body_dofs(b) {
-            z[lay.acc_row(&sys.acc_bodies, g).expect("an acceleration body") - lay.z()] = udot0[g];
-        }
-    }
+    lay.set_accelerations(sys, &udot0, z);
     let mut y = lay.assemble(q, u, z, &multipliers0);
     let udot = solve_loop(sys, lay, t, inputs, &mut y, udot0)?;
     z.copy_from_slice(&y[lay.z_range()]);

@@ -6,8 +6,7 @@ use super::kkt::push_p_blocks;
 use crate::ad::{Dual, Real};
 use crate::dae::sparse::{SparseLu, Triplets};
 use crate::mechanics::System;
-use crate::mechanics::constraint_jacobian::global_column;
-use crate::mechanics::kernels::gather;
+use crate::mechanics::coords::{gather, global_column};
 use crate::mechanics::local::LocalCtx;
 use crate::mechanics::nonholonomic_jacobian::nonholonomic_b;
 
