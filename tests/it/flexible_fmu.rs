@@ -131,3 +131,38 @@ fn the_fmu_of_a_flexible_model_carries_its_data_and_linearizes_like_the_engine()
     eprintln!("flexible FMU: {} knowns × {} unknowns, max relative difference {worst:e}", knowns.len(), uvr.len());
     free(c);
 }
+
+/// A modal data file given by an absolute path cannot travel with the FMU: `mbfmu pack`
+/// refuses it at the element (exit code 2, `file:line:col`) and writes nothing.
+#[test]
+fn pack_refuses_modal_data_outside_the_model_directory() {
+    let data = beam(&BeamSpec {
+        length: 0.6,
+        elements: 6,
+        section: Section { area: 1e-3, iy: 2e-9, iz: 1e-9, j: 3e-9 },
+        material: Material { young: 7e9, shear: 2.7e9, density: 2700.0 },
+        modes: 2,
+        damping: None,
+        clamp: Some(0),
+        reduction: Reduction::FreeInterface,
+    })
+    .unwrap();
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("flexible-fmu-outside");
+    std::fs::create_dir_all(&dir).unwrap();
+    let data_path = dir.join("beam.json");
+    std::fs::write(&data_path, write(&data)).unwrap();
+    let model = dir.join("abs.xml");
+    std::fs::write(&model, MODEL.replace("data/beam.json", data_path.to_str().unwrap())).unwrap();
+    let fmu = dir.join("abs.fmu");
+    let arg = |p: &std::path::Path| p.to_str().expect("UTF-8 path").to_string();
+    let o = mbfmu(&["pack", &arg(&model), "-o", &arg(&fmu)]);
+    assert_eq!(o.status.code(), Some(2), "{}", String::from_utf8_lossy(&o.stderr));
+    let err = String::from_utf8_lossy(&o.stderr);
+    let want = format!(
+        "{}:5:3: flexible_body 'beam': modal data '{}': to be packed into the FMU it must be a relative path inside the model file's directory",
+        model.display(),
+        data_path.display()
+    );
+    assert!(err.contains(&want), "{err}\nexpected: {want}");
+    assert!(!fmu.exists());
+}
