@@ -236,6 +236,8 @@ fn main() {
 /// What the lifecycle needs to know of the model: its text and value references.
 struct Plan {
     text: String,
+    /// The GUID of its FMU.
+    guid: String,
     steps: usize,
     n_vars: usize,
     /// States and inputs.
@@ -272,6 +274,7 @@ impl Plan {
                 .filter(|v| matches!(v.causality, Causality::Parameter | Causality::Input) && !v.target.is_integer())
                 .filter_map(|v| Some((v.value_reference, v.start?)))
                 .collect(),
+            guid: guid(&model, &text),
             text,
         }
     }
@@ -284,7 +287,7 @@ fn lifecycle(p: &Plan) -> String {
     if !instantiate("{00000000-0000-0000-0000-000000000000}", &uri).is_null() {
         fail(std::ptr::null_mut(), "fmi2Instantiate accepted a wrong GUID");
     }
-    let c = instantiate(&guid(&p.text), &uri);
+    let c = instantiate(&p.guid, &uri);
     if c.is_null() {
         fail(c, "fmi2Instantiate returned NULL");
     }

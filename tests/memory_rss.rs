@@ -83,7 +83,11 @@ impl Fmu {
         let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
         let text = std::fs::read_to_string(root.join("models/pendulum.xml")).unwrap();
         let (dir, uri) = resources(&text, &format!("memory rss {test}"));
-        Fmu { guid: CString::new(guid(&text)).unwrap(), uri, dir }
+        Fmu {
+            guid: CString::new(guid(&mbfmu::model::parse::load_str(&text, "model.xml").unwrap(), &text)).unwrap(),
+            uri,
+            dir,
+        }
     }
 
     fn instantiate(&self) -> Component {

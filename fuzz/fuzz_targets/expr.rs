@@ -18,8 +18,8 @@ use libfuzzer_sys::fuzz_target;
 use mbfmu::ad::{Dual, Real};
 use mbfmu::geom::{V3, rot313};
 use mbfmu::model::expr::{
-    Deps, ElementRef, Expr, ExprEnv, LoadFn, MarkerId, NameRef, Pose, Scope, Twist, angle_count, const_value, deps,
-    eval, function_names, is_constant, parse,
+    Deps, ElementRef, Expr, ExprEnv, LoadFn, MarkerId, ModalFn, NameRef, Pose, Scope, Twist, angle_count, const_value,
+    deps, eval, function_names, is_constant, parse,
 };
 use std::cell::RefCell;
 
@@ -75,6 +75,16 @@ impl Scope for FuzzScope {
                 _ => ElementRef::Sforce(0),
             },
         })
+    }
+    /// `f` (and some other names) is a flexible body with three modes, on marker a or b.
+    fn flexible(&self, name: &str) -> Option<(MarkerId, usize)> {
+        match name {
+            "f" => Some((0, 3)),
+            _ => match hash(name) % 8 {
+                h @ (0 | 1) => Some((h as MarkerId, 3)),
+                _ => None,
+            },
+        }
     }
 }
 
@@ -177,6 +187,15 @@ impl<T: Real> ExprEnv<T> for Env<T> {
             _ => -2.0,
         };
         self.v(c * (1.0 + f as usize as f64) * self.s, D_LOAD)
+    }
+    fn modal(&self, f: ModalFn, m: MarkerId, k: usize) -> T {
+        let x = 0.2 * (k as f64 + 1.0) * self.s;
+        match (f, m) {
+            (ModalFn::Rate, 0 | 1) => self.v(x, D_VEL),
+            (ModalFn::Coordinate, 0) => self.v(x, D_POS_A),
+            (ModalFn::Coordinate, 1) => self.v(x, D_POS_B),
+            _ => T::cst(f64::NAN),
+        }
     }
     fn unwrap_angle(&self, slot: usize, a: T) -> T {
         self.slots.borrow_mut().push(slot);

@@ -116,12 +116,12 @@ unsafe fn instantiate(
     let file = dir.join("model.xml");
     let model_text =
         std::fs::read_to_string(&file).map_err(|e| fail(format!("cannot read {}: {e}", file.display())))?;
-    let own = guid(&model_text);
+    let model = crate::model::parse::load_str(&model_text, &file.display().to_string())
+        .map_err(|e| fail(format!("invalid model: {e}")))?;
+    let own = guid(&model, &model_text);
     if given != own {
         return Err(fail(format!("fmuGUID {given} does not match this FMU's {own} (model {})", file.display())));
     }
-    let model = crate::model::parse::load_str(&model_text, &file.display().to_string())
-        .map_err(|e| fail(format!("invalid model: {e}")))?;
     let layout = super::pack::read_layout(&dir, &own).map_err(|e| fail(format!("no state layout: {e}")))?;
     Ok((model, own, layout))
 }

@@ -1,5 +1,8 @@
-//! Identity of an FMU: its GUID (a hash of the model text and the engine version, so a
-//! changed model or engine gives a new GUID) and its modelIdentifier (from the model name).
+//! Identity of an FMU: its GUID (a hash of the model text, the modal data of its flexible
+//! bodies and the engine version, so a changed model, modal data or engine gives a new
+//! GUID) and its modelIdentifier (from the model name).
+
+use crate::model::Model;
 
 /// Engine version: crate version and a fingerprint of the engine sources (build.rs).
 pub const ENGINE_VERSION: &str = concat!(env!("CARGO_PKG_VERSION"), "+", env!("MBFMU_ENGINE_FINGERPRINT"));
@@ -24,9 +27,14 @@ pub fn checksum(bytes: &[u8]) -> u64 {
     fnv1a128(&[bytes]) as u64
 }
 
-/// The GUID of the FMU of `model_text`: `{8-4-4-4-12}` hex digits.
-pub fn guid(model_text: &str) -> String {
-    let h = fnv1a128(&[ENGINE_VERSION.as_bytes(), model_text.as_bytes()]);
+/// The GUID of the FMU of `model`, read from `model_text`: `{8-4-4-4-12}` hex digits.
+/// The modal data of the flexible bodies enter by their values
+/// ([`Model::modal_data_texts`]), not their files' formatting.
+pub fn guid(model: &Model, model_text: &str) -> String {
+    let modal = model.modal_data_texts();
+    let mut parts = vec![ENGINE_VERSION.as_bytes(), model_text.as_bytes()];
+    parts.extend(modal.iter().map(|m| m.as_bytes()));
+    let h = fnv1a128(&parts);
     let s = format!("{h:032x}");
     format!("{{{}-{}-{}-{}-{}}}", &s[0..8], &s[8..12], &s[12..16], &s[16..20], &s[20..32])
 }
@@ -45,11 +53,15 @@ pub fn model_identifier(name: &str) -> String {
 mod tests {
     use super::*;
 
+    fn of(text: &str) -> String {
+        guid(&crate::model::parse::load_str(text, "m.xml").expect("a model"), text)
+    }
+
     #[test]
     fn guid_changes_with_the_model_text_and_is_well_formed() {
-        let (a, b) = (guid("<multibody a/>"), guid("<multibody b/>"));
+        let (a, b) = (of("<multibody name=\"a\" version=\"1\"/>"), of("<multibody name=\"b\" version=\"1\"/>"));
         assert_ne!(a, b);
-        assert_eq!(a, guid("<multibody a/>"));
+        assert_eq!(a, of("<multibody name=\"a\" version=\"1\"/>"));
         assert_eq!(a.len(), 38);
         assert!(a.starts_with('{') && a.ends_with('}'));
         assert_eq!(model_identifier("double pendulum-2"), "double_pendulum_2");

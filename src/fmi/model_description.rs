@@ -32,7 +32,7 @@ pub fn describe(model: &Model, model_text: &str, layout: &StateLayout, structure
     x.push_str("<fmiModelDescription\n");
     attr_line(&mut x, "fmiVersion", "2.0");
     attr_line(&mut x, "modelName", &model.name);
-    attr_line(&mut x, "guid", &guid(model_text));
+    attr_line(&mut x, "guid", &guid(model, model_text));
     attr_line(&mut x, "description", &format!("Multibody model {}", model.name));
     attr_line(&mut x, "generationTool", &format!("mbfmu {ENGINE_VERSION}"));
     attr_line(&mut x, "variableNamingConvention", "structured");

@@ -162,7 +162,7 @@ fn contents(model_path: &Path) -> Result<Contents, PackError> {
     let lib = library()?;
     let FmuLinearization { layout, structure } = for_fmu(&model);
     let xml = model_description::describe(&model, text, &layout, &structure);
-    let guid = guid(text);
+    let guid = guid(&model, text);
     let warnings = layout
         .missing
         .iter()
@@ -220,8 +220,9 @@ fn modal_files(model: &crate::model::Model) -> Result<Vec<(String, Vec<u8>)>, Pa
 /// when the caller's is small (as in the exports).
 pub fn layout_file(model_text: &str, label: &str) -> Result<(Vec<u8>, Option<String>), ModelError> {
     super::guard::with_stack(|| {
-        let layout = StateLayout::at_start(&load_str(model_text, label)?);
-        Ok((layout.to_text(&guid(model_text)).into_bytes(), layout.missing))
+        let model = load_str(model_text, label)?;
+        let layout = StateLayout::at_start(&model);
+        Ok((layout.to_text(&guid(&model, model_text)).into_bytes(), layout.missing))
     })
 }
 

@@ -31,6 +31,7 @@ impl System {
         let neta: usize = flex.iter().map(|f| f.eta.len()).sum();
         bodies.q_init.resize(bodies.q_init.len() + neta, 0.0);
         bodies.u_init.resize(bodies.u_init.len() + neta, 0.0);
+        initial_modal_state(model, &flex, &mut bodies);
         let markers = markers(model);
         let mut slots = AngleSlots::default();
         let (mut constraints, mut ic_constraints, ic_velocities) = constraints_and_ics(model, &markers, &mut slots);
@@ -184,6 +185,20 @@ fn flexible_bodies(model: &Model) -> Vec<FlexBody> {
         }
     }
     out
+}
+
+/// The flexible bodies' initial modal coordinates and rates (`modal_coordinates`,
+/// `modal_velocities`; zero when not given) into the initial q and u.
+fn initial_modal_state(model: &Model, flex: &[FlexBody], bodies: &mut Bodies) {
+    for f in flex {
+        let Some(spec) = &model.bodies[f.body].flex else { continue };
+        if let Some(v) = &spec.eta0 {
+            bodies.q_init[f.eta.clone()].copy_from_slice(&v.values());
+        }
+        if let Some(v) = &spec.eta_dot0 {
+            bodies.u_init[f.eta.clone()].copy_from_slice(&v.values());
+        }
+    }
 }
 
 /// The bodies (sorted, each once) of markers `ms` and of the markers the expressions

@@ -9,7 +9,7 @@ use super::load_components::load_index;
 use super::system::System;
 use crate::ad::Real;
 use crate::geom::{M3, V3};
-use crate::model::expr::{ElementRef, Expr, ExprEnv, LoadFn, MarkerId, Pose, Twist, eval};
+use crate::model::expr::{ElementRef, Expr, ExprEnv, LoadFn, MarkerId, ModalFn, Pose, Twist, eval};
 use std::cell::{Cell, RefCell};
 
 /// State of one body as seen by an element.
@@ -242,6 +242,16 @@ impl<T: Real> ExprEnv<T> for LocalCtx<'_, T> {
                 None => T::cst(f64::NAN),
             },
         }
+    }
+    /// η_k or η̇_k of the body marker `m` is on (NaN for a rigid body or ground; the
+    /// parser only lets flexible bodies' modes through).
+    fn modal(&self, f: ModalFn, m: MarkerId, k: usize) -> T {
+        let level = match f {
+            ModalFn::Coordinate => 0,
+            ModalFn::Rate => 1,
+        };
+        let local = self.sys.markers[m].body.map(|b| self.local(b));
+        local.and_then(|l| self.modal[l][level].get(k).copied()).unwrap_or(T::cst(f64::NAN))
     }
     /// Angles stay on the branch nearest their value at the last accepted step.
     fn unwrap_angle(&self, slot: usize, a: T) -> T {

@@ -106,6 +106,10 @@ pub struct FlexSpec {
     pub path: String,
     /// The validated modal data.
     pub data: crate::modal::ModalData,
+    /// Initial modal coordinates η(t0), one per mode (`modal_coordinates`; None = 0).
+    pub eta0: Option<NumVec>,
+    /// Initial modal rates η̇(t0), one per mode (`modal_velocities`; None = 0).
+    pub eta_dot0: Option<NumVec>,
 }
 
 /// `<marker>` (also the implicit `cm` marker of each body). Full name `body.marker`.

@@ -3,13 +3,13 @@
 //! a step-size collapse at a lock-up) returns fmi2Discard with fmi2LastSuccessfulTime =
 //! the time reached; restoring an FMU state lets the host retry or continue.
 
+use crate::common::guid;
 use crate::common::host::{self, free, get, messages, resources};
 use crate::common::{model_text, root};
 use mbfmu::dae::{DEFAULT_MAX_STEPS, SimOptions, Simulator};
 use mbfmu::fmi::exports_common::*;
 use mbfmu::fmi::exports_cs::*;
 use mbfmu::fmi::exports_state::*;
-use mbfmu::fmi::guid::guid;
 use mbfmu::fmi::model_description::write;
 use mbfmu::fmi::state_machine::State;
 use mbfmu::fmi::types::{CO_SIMULATION, Component, LAST_SUCCESSFUL_TIME, Status};

@@ -2,11 +2,11 @@
 //! lists, and every partial derivative that fmi2GetDirectionalDerivative returns outside
 //! the declared dependencies is exactly zero (every example model, moving).
 
+use crate::common::guid;
 use crate::common::host::{CALLBACKS, resources};
 use crate::common::model_dir;
 use mbfmu::fmi::exports_common::*;
 use mbfmu::fmi::exports_cs::*;
-use mbfmu::fmi::guid::guid;
 use mbfmu::fmi::model_description::write;
 use mbfmu::fmi::types::{CO_SIMULATION, Component, Status};
 use mbfmu::model::parse::load_str;

@@ -21,6 +21,9 @@ impl Scope for OneBody {
     fn element(&self, _: &str) -> Option<ElementRef> {
         None
     }
+    fn flexible(&self, _: &str) -> Option<(MarkerId, usize)> {
+        None
+    }
 }
 
 /// A marker on a rotating arm: angle q = z0, radius r = z1, at time t; pin at the origin.

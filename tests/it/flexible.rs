@@ -144,3 +144,51 @@ fn bad_modal_data_names_the_element_the_file_and_the_entry() {
     let e = load_in(&dir, &model_text("").replace("arm.json", "none.json")).unwrap_err();
     assert!(e.contains(":2:29: flexible_body 'arm': modal data: ") && e.contains("none.json"), "{e}");
 }
+
+/// Initial modal coordinates and rates, and expressions reading modes: read with the
+/// body's mode count; a wrong count or mode number is refused at the attribute.
+#[test]
+fn modal_initial_conditions_and_modal_measures_are_read_and_checked() {
+    let dir = dir_with("modal-ics", DATA);
+    let text = |attrs: &str, f: &str| {
+        format!(
+            r#"<multibody name="f" version="1">
+  <output name="y" function="{f}"/>
+  <flexible_body name="arm" modal="arm.json" position="1 2 3" {attrs}/>
+  <body name="r" mass="1" inertia="1 1 1" position="0 0 0"/>
+</multibody>
+"#
+        )
+    };
+    // An expression before the body it reads: modes are known from the first pass.
+    let m =
+        load_in(&dir, &text(r#"modal_coordinates="0.1 -0.2" modal_velocities="0 3""#, "modal_rate(arm, 2)")).unwrap();
+    let f = m.bodies[0].flex.as_ref().unwrap();
+    assert_eq!(f.eta0.as_ref().map(|v| v.values()), Some(vec![0.1, -0.2]));
+    assert_eq!(f.eta_dot0.as_ref().map(|v| v.values()), Some(vec![0.0, 3.0]));
+    // A parameter in them is re-evaluated with new parameter values (FMU parameters, sweeps).
+    let with_param =
+        text(r#"modal_coordinates="a 2*a""#, "1").replace("<output", "<parameter name=\"a\" value=\"1\"/>\n  <output");
+    let m = load_in(&dir, &with_param).unwrap().with_params(&[0.25]).unwrap();
+    assert_eq!(m.bodies[0].flex.as_ref().unwrap().eta0.as_ref().map(|v| v.values()), Some(vec![0.25, 0.5]));
+    let at = |s: &str| format!("{}:{s}", dir.join("m.xml").display());
+    let cases = [
+        (
+            text(r#"modal_coordinates="0.1""#, "1"),
+            at("3:63: flexible_body 'arm': attribute 'modal_coordinates' needs 2 items, found 1"),
+        ),
+        (
+            text("", "modal(arm, 3)"),
+            at("2:41: output 'y': bad expression in 'function': mode 3 of 'arm': it has modes 1 to 2"),
+        ),
+        (
+            text("", "modal(r, 1)"),
+            at(
+                "2:36: output 'y': bad expression in 'function': 'r' is not a flexible body: 'modal' reads a <flexible_body>'s modes",
+            ),
+        ),
+    ];
+    for (t, want) in cases {
+        assert_eq!(load_in(&dir, &t).unwrap_err(), want);
+    }
+}

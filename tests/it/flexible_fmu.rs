@@ -166,3 +166,32 @@ fn pack_refuses_modal_data_outside_the_model_directory() {
     assert!(err.contains(&want), "{err}\nexpected: {want}");
     assert!(!fmu.exists());
 }
+
+/// The GUID covers the modal data: the same model text with other modal values gets
+/// another GUID (an FMU whose data changed is another FMU), while the same values written
+/// differently (whitespace) keep it.
+#[test]
+fn the_guid_changes_with_the_modal_data_values() {
+    let spec = |damping| BeamSpec {
+        length: 0.6,
+        elements: 6,
+        section: Section { area: 1e-3, iy: 2e-9, iz: 1e-9, j: 3e-9 },
+        material: Material { young: 7e9, shear: 2.7e9, density: 2700.0 },
+        modes: 2,
+        damping,
+        clamp: Some(0),
+        reduction: Reduction::FreeInterface,
+    };
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("flexible-fmu-guid");
+    std::fs::create_dir_all(dir.join("data")).unwrap();
+    let label = dir.join("m.xml").display().to_string();
+    let guid_with = |json: &str| {
+        std::fs::write(dir.join("data/beam.json"), json).unwrap();
+        let m = mbfmu::model::load_str(MODEL, &label).unwrap_or_else(|e| panic!("{e}"));
+        mbfmu::fmi::guid::guid(&m, MODEL)
+    };
+    let json = write(&beam(&spec(Some(0.02))).unwrap());
+    let g = guid_with(&json);
+    assert_eq!(g, guid_with(&json.replace('\n', "\n  ")));
+    assert_ne!(g, guid_with(&write(&beam(&spec(Some(0.03))).unwrap())));
+}

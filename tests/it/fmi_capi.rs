@@ -2,6 +2,7 @@
 //! the engine's own, FMU states, parameters, every refused call with its message, engine
 //! failures as fmi2Discard, and many instances.
 
+use crate::common::guid;
 use crate::common::host::{self, CALLBACKS, free, get, last_message, messages, resources};
 use crate::common::model_text;
 use mbfmu::dae::{SimOptions, Simulator};
@@ -9,7 +10,6 @@ use mbfmu::fmi::exports_common::*;
 use mbfmu::fmi::exports_cs::*;
 use mbfmu::fmi::exports_me::fmi2SetTime;
 use mbfmu::fmi::exports_state::*;
-use mbfmu::fmi::guid::guid;
 use mbfmu::fmi::state_machine::State;
 use mbfmu::fmi::types::{CO_SIMULATION, Component, LAST_SUCCESSFUL_TIME, MODEL_EXCHANGE, Status};
 use std::ffi::CString;

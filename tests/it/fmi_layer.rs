@@ -2,8 +2,8 @@
 //! those `mbfmu linearize` selects, they reach an instance from the FMU's resources (no
 //! engine run at fmi2Instantiate), and a missing or foreign layout is refused there.
 
+use crate::common::guid;
 use mbfmu::fmi::exports_common::*;
-use mbfmu::fmi::guid::guid;
 use mbfmu::fmi::pack::{LAYOUT_FILE, read_layout};
 use mbfmu::fmi::types::CO_SIMULATION;
 use mbfmu::fmi::variables::{Target, variables};

@@ -9,13 +9,13 @@
 //! `MBFMU_FMI_SEQUENCES` (default 300, what CI runs) sets how many sequences;
 //! `MBFMU_FMI_SEED` the base seed; `bench/fmi_sequences.sh` runs thousands.
 
+use crate::common::guid;
 use crate::common::host::{self, CALLBACKS, resources};
 use crate::common::model_files;
 use mbfmu::fmi::exports_common::*;
 use mbfmu::fmi::exports_cs::*;
 use mbfmu::fmi::exports_me::*;
 use mbfmu::fmi::exports_state::*;
-use mbfmu::fmi::guid::guid;
 use mbfmu::fmi::types::{
     CO_SIMULATION, Component, DO_STEP_STATUS, FmuStatePtr, LAST_SUCCESSFUL_TIME, Status, TERMINATED,
 };

@@ -96,7 +96,7 @@ fn pack_writes_the_fmu_zip_and_directory() {
     assert!(xml.contains("modelIdentifier=\"pendulum\""));
     let guid = guid_of(&xml);
     assert!(stdout.contains(&guid), "the summary names the GUID: {stdout}");
-    assert_eq!(guid, mbfmu::fmi::guid::guid(&text(&model_bytes)));
+    assert_eq!(guid, crate::common::guid(&text(&model_bytes)));
 
     // The unzipped tree holds the same files.
     for (name, data) in &entries {

@@ -96,6 +96,26 @@ pub enum LoadFn {
     Tz,
 }
 
+/// Modal measures of a flexible body: `modal(body, k)` (coordinate η_k) and
+/// `modal_rate(body, k)` (its rate η̇_k).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ModalFn {
+    /// η_k, as the modal data's shapes scale it.
+    Coordinate,
+    /// η̇_k (1/s in the same scale).
+    Rate,
+}
+
+impl ModalFn {
+    /// 0 = positions, 1 = velocities (as [`KinFn::level`]).
+    pub fn level(self) -> u8 {
+        match self {
+            ModalFn::Coordinate => 0,
+            ModalFn::Rate => 1,
+        }
+    }
+}
+
 /// What a load function names.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ElementRef {
@@ -142,4 +162,7 @@ pub enum Expr {
     Kin(KinFn, MarkerId, Option<MarkerId>, Option<MarkerId>),
     /// A load component of an element: `fx(name)` ...
     Load(LoadFn, ElementRef),
+    /// A modal coordinate or rate of a flexible body: the body's `cm` marker and the mode
+    /// index from 0 (`modal(arm, 1)` is mode index 0).
+    Modal(ModalFn, MarkerId, usize),
 }

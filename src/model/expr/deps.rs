@@ -8,9 +8,11 @@ use crate::geom::{M3, V3};
 /// Everything an expression reads. Every list is sorted and free of duplicates.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Deps {
-    /// Markers named in kinematic measures (i, j and k).
+    /// Markers named in kinematic measures (i, j and k), and the `cm` markers of the
+    /// flexible bodies whose modal coordinates it reads.
     pub markers: Vec<MarkerId>,
-    /// Highest [`super::KinFn::level`] of its kinematic measures; 0 if none.
+    /// Highest [`super::KinFn::level`] (or [`super::ModalFn::level`]) of its kinematic
+    /// and modal measures; 0 if none.
     pub level: u8,
     /// Reads `time`.
     pub time: bool,
@@ -76,6 +78,10 @@ fn collect(e: &Expr, d: &mut Deps) {
             d.level = d.level.max(f.level());
         }
         Expr::Load(_, r) => d.loads.push(*r),
+        Expr::Modal(f, m, _) => {
+            d.markers.push(*m);
+            d.level = d.level.max(f.level());
+        }
     }
 }
 

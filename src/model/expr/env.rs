@@ -1,7 +1,7 @@
 //! What an expression reads when it is evaluated: implemented by the mechanics layer,
 //! generic over the scalar so that evaluation with dual numbers gives exact derivatives.
 
-use super::ast::{ElementRef, LoadFn, MarkerId};
+use super::ast::{ElementRef, LoadFn, MarkerId, ModalFn};
 use crate::ad::Real;
 use crate::geom::{M3, V3};
 
@@ -47,6 +47,11 @@ pub trait ExprEnv<T: Real> {
     fn accel(&self, m: MarkerId) -> Twist<T>;
     /// Load that element `e` applies on its i marker (ground components).
     fn load(&self, f: LoadFn, e: ElementRef) -> T;
+    /// Modal coordinate or rate `k` (from 0) of the flexible body that marker `m` is on;
+    /// default NaN (an environment without flexible bodies).
+    fn modal(&self, _f: ModalFn, _m: MarkerId, _k: usize) -> T {
+        T::cst(f64::NAN)
+    }
     /// Continuous (unwrapped) version of an angle measure: the engine keeps each angle
     /// near its previous value. `slot` identifies the measure; default: no unwrapping.
     fn unwrap_angle(&self, _slot: usize, a: T) -> T {

@@ -62,6 +62,7 @@ fn ev<T: Real, E: ExprEnv<T> + ?Sized>(e: &Expr, env: &E, slot: &mut usize) -> T
             }
         }
         Expr::Load(f, el) => env.load(*f, *el),
+        Expr::Modal(f, m, k) => env.modal(*f, *m, *k),
     }
 }
 

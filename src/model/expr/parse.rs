@@ -9,7 +9,7 @@
 //! primary := number | name | name '(' args ')' | '(' sum ')'
 //! ```
 
-use super::ast::{BinOp, ElementRef, Expr, KinFn, LoadFn, MarkerId, MathFn};
+use super::ast::{BinOp, ElementRef, Expr, KinFn, LoadFn, MarkerId, MathFn, ModalFn};
 use super::lexer::{Tok, Token, lex};
 use super::scope::{ExprError, NameRef, Scope};
 
@@ -25,12 +25,63 @@ pub fn function_names() -> &'static [&'static str] {
 
 const FUNCTION_NAMES: &[&str] = &[
     // math
-    "sin", "cos", "tan", "asin", "acos", "atan", "atan2", "sinh", "cosh", "tanh", "exp", "log", "sqrt", "abs", "sign",
-    "min", "max", "step", "if", // kinematics
-    "dx", "dy", "dz", "dm", "vx", "vy", "vz", "vm", "vr", "wx", "wy", "wz", "wm", "accx", "accy", "accz", "wdtx",
-    "wdty", "wdtz", "ax", "ay", "az", "psi", "theta", "phi", "yaw", "pitch", "roll", // loads
-    "fx", "fy", "fz", "tx", "ty", "tz", // differentials
-    "dif", "dif1",
+    "sin",
+    "cos",
+    "tan",
+    "asin",
+    "acos",
+    "atan",
+    "atan2",
+    "sinh",
+    "cosh",
+    "tanh",
+    "exp",
+    "log",
+    "sqrt",
+    "abs",
+    "sign",
+    "min",
+    "max",
+    "step",
+    "if", // kinematics
+    "dx",
+    "dy",
+    "dz",
+    "dm",
+    "vx",
+    "vy",
+    "vz",
+    "vm",
+    "vr",
+    "wx",
+    "wy",
+    "wz",
+    "wm",
+    "accx",
+    "accy",
+    "accz",
+    "wdtx",
+    "wdty",
+    "wdtz",
+    "ax",
+    "ay",
+    "az",
+    "psi",
+    "theta",
+    "phi",
+    "yaw",
+    "pitch",
+    "roll", // loads
+    "fx",
+    "fy",
+    "fz",
+    "tx",
+    "ty",
+    "tz", // differentials
+    "dif",
+    "dif1", // flexible bodies
+    "modal",
+    "modal_rate",
 ];
 
 /// The keywords `pi` and `time` (not functions, but reserved like them).
@@ -100,6 +151,16 @@ impl MathFn {
             "if" => If,
             _ => return None,
         })
+    }
+}
+
+impl ModalFn {
+    fn from_name(s: &str) -> Option<Self> {
+        match s {
+            "modal" => Some(ModalFn::Coordinate),
+            "modal_rate" => Some(ModalFn::Rate),
+            _ => None,
+        }
     }
 }
 
@@ -432,6 +493,9 @@ impl Parser<'_> {
             let d = self.deeper(d, off)?;
             return Ok((Expr::Math(f, args), d));
         }
+        if let Some(f) = ModalFn::from_name(name) {
+            return self.modal_args(f, name);
+        }
         let kin = KinFn::from_name(name);
         let load = LoadFn::from_name(name);
         let dif = matches!(name, "dif" | "dif1");
@@ -474,6 +538,37 @@ impl Parser<'_> {
             Some(_) => Err(err(*aoff, format!("'{a}' is not a differential"))),
             None => Err(err(*aoff, format!("unknown name '{a}'"))),
         }
+    }
+
+    /// The arguments of `modal(body, k)` / `modal_rate(body, k)` after the `(`: a flexible
+    /// body's name and a mode number from 1 (a whole number literal), then `)`.
+    fn modal_args(&mut self, f: ModalFn, name: &str) -> Result<Node, ExprError> {
+        let usage = || format!("'{name}' takes a flexible body and a mode number: {name}(body, k)");
+        let (body, boff) = match self.peek().clone() {
+            Tok::Ident(s) => (s, self.offset()),
+            Tok::End | Tok::Bad(_) => return Err(self.unexpected()),
+            _ => return Err(err(self.offset(), usage())),
+        };
+        self.bump();
+        if !self.is_sym(',') {
+            return Err(err(self.offset(), usage()));
+        }
+        self.bump();
+        let (k, koff) = match *self.peek() {
+            Tok::Num(v) => (v, self.offset()),
+            Tok::End | Tok::Bad(_) => return Err(self.unexpected()),
+            _ => return Err(err(self.offset(), usage())),
+        };
+        self.bump();
+        self.expect(')')?;
+        let (cm, modes) = self.scope.flexible(&body).ok_or_else(|| {
+            let what = if self.scope.marker(&body).is_some() { "is not a flexible body" } else { "is unknown" };
+            err(boff, format!("'{body}' {what}: '{name}' reads a <flexible_body>'s modes"))
+        })?;
+        if k.fract() != 0.0 || k < 1.0 || k > modes as f64 {
+            return Err(err(koff, format!("mode {k} of '{body}': it has modes 1 to {modes}")));
+        }
+        Ok((Expr::Modal(f, cm, k as usize - 1), 1))
     }
 
     /// Arguments that are bare names (markers, elements, differentials), up to and

@@ -35,6 +35,8 @@ pub trait Scope {
     fn marker(&self, name: &str) -> Option<MarkerId>;
     /// An element named in `fx(name)` and the other load functions.
     fn element(&self, name: &str) -> Option<ElementRef>;
+    /// A flexible body named in `modal(name, k)`: its `cm` marker and its number of modes.
+    fn flexible(&self, name: &str) -> Option<(MarkerId, usize)>;
 }
 
 /// A parse error at a character offset of the expression text.

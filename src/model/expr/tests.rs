@@ -12,7 +12,8 @@ use std::cell::RefCell;
 // ---------------------------------------------------------------------------------------
 
 /// Names: params p0 p1, inputs u0 u1, variable v0, differentials x0 x1; markers a (bare
-/// body), b.m, c.k, ground.O; elements j1 (joint), s0 (sforce), g2 (gforce).
+/// body), b.m, c.k, ground.O; elements j1 (joint), s0 (sforce), g2 (gforce); flexible body
+/// flex (cm marker 5, three modes).
 struct MockScope;
 
 impl Scope for MockScope {
@@ -44,6 +45,9 @@ impl Scope for MockScope {
             "g2" => ElementRef::Gforce(2),
             _ => return None,
         })
+    }
+    fn flexible(&self, name: &str) -> Option<(MarkerId, usize)> {
+        (name == "flex").then_some((5, 3))
     }
 }
 
@@ -557,7 +561,7 @@ fn names_resolve_to_the_right_nodes() {
 #[test]
 fn function_names_lists_every_function_and_each_parses() {
     let names = function_names();
-    assert_eq!(names.len(), 19 + 28 + 6 + 2);
+    assert_eq!(names.len(), 19 + 28 + 6 + 2 + 2);
     for n in names {
         // Every listed name is recognised as a function (an arity error, not "unknown").
         let e = parse(&format!("{n}()"), &MockScope).unwrap_err();
@@ -662,5 +666,28 @@ fn random_garbage_never_panics() {
         if let Err(e) = parse(&src, &MockScope) {
             assert!(e.offset <= src.chars().count());
         }
+    }
+}
+
+#[test]
+fn modal_measures_parse_to_the_body_cm_marker_and_a_mode_index_from_zero() {
+    assert_eq!(p("modal(flex, 2)"), Expr::Modal(ModalFn::Coordinate, 5, 1));
+    assert_eq!(p("modal_rate( flex ,3 )"), Expr::Modal(ModalFn::Rate, 5, 2));
+    let d = deps(&p("2*modal(flex, 1) + modal_rate(flex, 3)"));
+    assert_eq!((d.markers, d.level), (vec![5], 1));
+    assert_eq!(deps(&p("modal(flex, 1)")).level, 0);
+    let cases = [
+        ("modal(a, 1)", 6, "'a' is not a flexible body: 'modal' reads a <flexible_body>'s modes"),
+        ("modal(zz, 1)", 6, "'zz' is unknown: 'modal' reads a <flexible_body>'s modes"),
+        ("modal(flex, 4)", 12, "mode 4 of 'flex': it has modes 1 to 3"),
+        ("modal(flex, 0)", 12, "mode 0 of 'flex': it has modes 1 to 3"),
+        ("modal_rate(flex, 1.5)", 17, "mode 1.5 of 'flex': it has modes 1 to 3"),
+        ("modal(flex)", 10, "'modal' takes a flexible body and a mode number: modal(body, k)"),
+        ("modal(flex, x0)", 12, "'modal' takes a flexible body and a mode number: modal(body, k)"),
+        ("modal(1, flex)", 6, "'modal' takes a flexible body and a mode number: modal(body, k)"),
+        ("modal(flex, 1", 13, "unexpected end of expression"),
+    ];
+    for (src, off, msg) in cases {
+        assert_eq!(parse_err(src), (off, msg.to_string()), "{src}");
     }
 }

@@ -11,25 +11,40 @@ use crate::model::*;
 use std::path::Path;
 
 impl<'a> Loader<'a> {
-    /// `<flexible_body>`: read and validate its modal data file, then the body (mass and
-    /// inertia of the undeformed body), its `cm` marker (at the undeformed centre of mass,
-    /// fixed in the body frame) and its node markers.
-    pub(super) fn build_flexible_body(&mut self, x: &'a XElem) -> Result<(), ModelError> {
+    /// The modal data file of a `<flexible_body>` (its `modal` attribute), read and
+    /// validated; errors at the attribute, naming the file and the entry.
+    pub(super) fn read_modal_data(&self, x: &'a XElem) -> Result<FlexSpec, ModelError> {
         let el = self.el(x);
         let attr = el.req("modal")?;
         let file = attr.value.clone();
         let path = resolve(&self.model.file, &file);
         let data = crate::modal::read(Path::new(&path)).map_err(|e| el.err_at(attr.pos, format!("modal data: {e}")))?;
-        let (mass, cm, inertia) = rigid_properties(&data);
+        Ok(FlexSpec { file, path, data, eta0: None, eta_dot0: None })
+    }
+
+    /// `<flexible_body>` (its modal data read when its name was declared): the body (mass
+    /// and inertia of the undeformed body), its `cm` marker (at the undeformed centre of
+    /// mass, fixed in the body frame), its node markers and its initial modal state.
+    pub(super) fn build_flexible_body(&mut self, x: &'a XElem) -> Result<(), ModelError> {
+        let idx = self.model.bodies.len();
+        let mut spec = match self.flex_data.remove(&idx) {
+            Some(s) => s,
+            None => self.read_modal_data(x)?,
+        };
+        let el = self.el(x);
+        let n = spec.data.modes.len();
+        spec.eta0 = el.num_vec("modal_coordinates", &[n])?;
+        spec.eta_dot0 = el.num_vec("modal_velocities", &[n])?;
+        let (mass, cm, inertia) = rigid_properties(&spec.data);
         let name = x.label().to_string();
         let j = [inertia[0][0], inertia[1][1], inertia[2][2], inertia[0][1], inertia[0][2], inertia[1][2]];
         let body = body_with(&el, x, constant(mass), NumVec { items: j.map(constant).to_vec() })?;
         let idx = self.push_body(body, cm);
         for m in &x.children {
-            let mk = self.node_marker(m, &name, idx, &data, &path)?;
+            let mk = self.node_marker(m, &name, idx, &spec.data, &spec.path)?;
             self.model.markers.push(mk);
         }
-        self.model.bodies[idx].flex = Some(FlexSpec { file, path, data });
+        self.model.bodies[idx].flex = Some(spec);
         Ok(())
     }
 

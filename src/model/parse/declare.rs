@@ -23,7 +23,18 @@ pub(crate) fn schema(tag: &str) -> Option<(&'static [&'static str], &'static [&'
             &["name", "mass", "inertia", "position"],
         ),
         "flexible_body" => (
-            &["name", "modal", "position", "euler313", "z_axis", "x_axis", "velocity", "angular_velocity"],
+            &[
+                "name",
+                "modal",
+                "position",
+                "euler313",
+                "z_axis",
+                "x_axis",
+                "velocity",
+                "angular_velocity",
+                "modal_coordinates",
+                "modal_velocities",
+            ],
             &["name", "modal", "position"],
         ),
         // `position` is required unless `node` is given (checked when built).
@@ -260,6 +271,11 @@ impl<'a> Loader<'a> {
         self.scope.markers.insert(format!("{name}.cm"), cm);
         self.scope.body_cm.insert(name.clone(), cm);
         self.scope.body_names.push(name.clone());
+        if x.tag == "flexible_body" {
+            let spec = self.read_modal_data(x)?;
+            self.scope.flexible.insert(name.clone(), (cm, spec.data.modes.len()));
+            self.flex_data.insert(idx, spec);
+        }
         self.declare_markers(x, &name, Some(idx))
     }
 

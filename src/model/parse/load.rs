@@ -5,7 +5,7 @@ use super::names::{ModelScope, Namespace, invalid_name};
 use super::params;
 use super::source::Source;
 use super::xml::{self, XElem};
-use crate::model::{Experiment, Model, ModelError, Num, Parameter};
+use crate::model::{Experiment, FlexSpec, Model, ModelError, Num, Parameter};
 use std::collections::HashMap;
 
 /// State of one model read.
@@ -39,6 +39,10 @@ pub(crate) struct Loader<'a> {
     pub ns_nonholonomic: Namespace,
     /// Once-only elements already seen, with their line.
     pub singletons: HashMap<String, usize>,
+    /// The modal data of each flexible body (by body index), read when its name is
+    /// declared (expressions check mode numbers against it) and moved into the body when
+    /// it is built.
+    pub flex_data: HashMap<usize, FlexSpec>,
     /// The model being filled in; returned once every pass has succeeded.
     pub model: Model,
 }
@@ -62,6 +66,7 @@ pub(crate) fn load(text: &str, file: &str) -> Result<Model, ModelError> {
         ns_lin: Namespace::default(),
         ns_nonholonomic: Namespace::default(),
         singletons: HashMap::new(),
+        flex_data: HashMap::new(),
         model: empty_model(file),
     };
     l.check_root()?;

@@ -76,6 +76,13 @@ impl Model {
         })
     }
 
+    /// The modal data of the flexible bodies, in body order, as [`crate::modal::write`]
+    /// gives them: their values, not their files' formatting (what identifies an FMU
+    /// beyond the model text).
+    pub fn modal_data_texts(&self) -> Vec<String> {
+        self.bodies.iter().filter_map(|b| b.flex.as_ref()).map(|f| crate::modal::write(&f.data)).collect()
+    }
+
     /// Every constant attribute (not the parameters' own values), for re-evaluation.
     fn nums_mut(&mut self) -> Vec<&mut Num> {
         let mut v: Vec<&mut Num> = Vec::new();
@@ -89,6 +96,9 @@ impl Model {
             v.extend(orientation_nums(&mut b.orientation));
             for w in [&mut b.velocity, &mut b.angular_velocity].into_iter().flatten() {
                 v.extend(vec_nums(w));
+            }
+            if let Some(f) = &mut b.flex {
+                v.extend([&mut f.eta0, &mut f.eta_dot0].into_iter().flatten().flat_map(vec_nums));
             }
         }
         for m in &mut self.markers {

@@ -63,6 +63,8 @@ pub(crate) struct ModelScope {
     pub body_cm: HashMap<String, MarkerId>,
     /// Elements that load functions can name (joints, motions, constraints, forces).
     pub elements: HashMap<String, (ElementRef, &'static str, usize)>,
+    /// Flexible body name to its `cm` marker and number of modes (`modal(body, k)`).
+    pub flexible: HashMap<String, (MarkerId, usize)>,
 }
 
 impl Scope for ModelScope {
@@ -74,5 +76,8 @@ impl Scope for ModelScope {
     }
     fn element(&self, name: &str) -> Option<ElementRef> {
         self.elements.get(name).map(|&(r, _, _)| r)
+    }
+    fn flexible(&self, name: &str) -> Option<(MarkerId, usize)> {
+        self.flexible.get(name).copied()
     }
 }

@@ -199,12 +199,17 @@ pub fn state(c: Component) -> Option<State> {
     }
 }
 
-/// `<tmp>/mbfmu <tag> 100% <pid> <guid>/resources/model.xml` holding `text`, with the state
+/// `<tmp>/mbfmu <tag> 100% <pid> <hash of text>/resources/model.xml` holding `text`, with the state
 /// layout `mbfmu pack` writes beside it (when the text is a model): the directory (remove
 /// it when done, if wanted) and the resource location's `file://` URI, with the space and
 /// the `%` of the path escaped as a host must.
 pub fn resources(text: &str, tag: &str) -> (PathBuf, CString) {
-    let id: String = mbfmu::fmi::guid::guid(text).chars().filter(char::is_ascii_hexdigit).collect();
+    let id = {
+        use std::hash::{Hash, Hasher};
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        text.hash(&mut h);
+        format!("{:016x}", h.finish())
+    };
     let top = std::env::temp_dir().join(format!("mbfmu {tag} 100% {} {id}", std::process::id()));
     let dir = top.join("resources");
     std::fs::create_dir_all(&dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));

@@ -52,6 +52,15 @@ pub fn model(name: &str) -> Model {
     load_file(&model_dir().join(name)).unwrap_or_else(|e| panic!("{e}"))
 }
 
+/// The GUID `mbfmu pack` gives the FMU of the model text `text` (one that does not load
+/// has none: a placeholder, which instantiation refuses with the model's error).
+pub fn guid(text: &str) -> String {
+    match mbfmu::model::parse::load_str(text, "model.xml") {
+        Ok(m) => mbfmu::fmi::guid::guid(&m, text),
+        Err(_) => "{not a model}".to_string(),
+    }
+}
+
 /// Run the `mbfmu` binary with `args` in the crate's root, without stdin.
 pub fn mbfmu(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_mbfmu"))
