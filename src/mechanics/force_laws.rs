@@ -1,6 +1,7 @@
 //! The force laws: loads and generalized forces of the force elements (Eq. 1d / 13a),
 //! evaluated in an element context.
 
+use super::coords::local_modal_range;
 use super::forces::{ForceEl, ForceKind, Load};
 use super::local::LocalCtx;
 use crate::ad::Real;
@@ -65,7 +66,8 @@ impl ForceEl {
         }
     }
 
-    /// Generalized forces on the context's bodies, accumulated into `q` (6 per local body).
+    /// Generalized forces on the context's bodies, accumulated into `q` (local coordinates:
+    /// 6 per body, then the modal ones of the flexible bodies; see [`super::coords`]).
     pub fn generalized<T: Real>(&self, ctx: &LocalCtx<T>, q: &mut [T]) {
         let l = self.load(ctx);
         let (i, j) = self.markers();
@@ -130,7 +132,11 @@ fn scalar_load<T: Real>(ctx: &LocalCtx<T>, kind: SpringType, i: MarkerId, j: Mar
     }
 }
 
-/// Add force `f` at ground point `p` and torque `t` to the body of marker `m` (if any).
+/// Add force `f` at ground point `p` and torque `t` to the body of marker `m` (if any),
+/// by virtual work: the six rigid rows, and, for a marker on a flexible body's node, the
+/// modal rows. The point p moves with the node: δx_p = δx_n + δθ_n × (p − x_n), with
+/// δx_n = A φ_k δη_k and δθ_n = A ρ_k δη_k from mode k, so
+/// Q_ηk = φ_k·(Aᵀ f) + ρ_k·(Aᵀ (t + (p − x_n) × f)).
 fn apply<T: Real>(ctx: &LocalCtx<T>, m: MarkerId, p: V3<T>, f: V3<T>, t: V3<T>, q: &mut [T]) {
     let Some(b) = ctx.sys.markers[m].body else { return };
     let k = ctx.local(b);
@@ -139,5 +145,13 @@ fn apply<T: Real>(ctx: &LocalCtx<T>, m: MarkerId, p: V3<T>, f: V3<T>, t: V3<T>, 
     for c in 0..3 {
         q[6 * k + c] += f.0[c];
         q[6 * k + 3 + c] += tq.0[c];
+    }
+    if let Some(shape) = &ctx.sys.markers[m].node {
+        let fb = body.a.tv(&f);
+        let tb = body.a.tv(&(t + (p - ctx.pose(m).p).cross(&f)));
+        let rows = local_modal_range(ctx.sys, ctx.ids, k);
+        for ((r, phi), rho) in rows.zip(&shape.phi).zip(&shape.rho) {
+            q[r] += fb.dot(&V3::cst(*phi)) + tb.dot(&V3::cst(*rho));
+        }
     }
 }
