@@ -68,6 +68,34 @@ pub fn select_states(sys: &System, q: &[f64], t: f64, inputs: &[f64]) -> Result<
     select_states_among(sys, q, t, inputs, Candidates::default())
 }
 
+/// Scale each modal-coordinate column of the selection matrix (constraint rows `fixed` and
+/// candidate rows `tiers`) to largest |entry| 1. Modal coordinates carry the data's
+/// normalization (a mass-normalized rotation shape at a light node can be hundreds of rad
+/// per unit η), which would otherwise set the rank tolerance for the rigid columns too. A
+/// column scaling is a change of units: it changes neither the rank nor which coordinates
+/// stay free; rigid models have no modal columns and are untouched.
+fn scale_modal_columns(sys: &System, fixed: &mut [(usize, usize, f64)], tiers: &mut [Vec<CandidateRow>]) {
+    let first = crate::mechanics::body::NQ * sys.nb();
+    let n = sys.n();
+    if first == n {
+        return;
+    }
+    let mut big = vec![0.0f64; n - first];
+    let rows = tiers.iter().flatten().flat_map(|r| r.entries.iter().map(|&(c, v)| (c, v)));
+    for (c, v) in fixed.iter().map(|&(_, c, v)| (c, v)).chain(rows) {
+        if c >= first {
+            big[c - first] = big[c - first].max(v.abs());
+        }
+    }
+    let scale = |c: usize, v: &mut f64| {
+        if c >= first && big[c - first] > 0.0 {
+            *v /= big[c - first];
+        }
+    };
+    fixed.iter_mut().for_each(|(_, c, v)| scale(*c, v));
+    tiers.iter_mut().flatten().flat_map(|r| r.entries.iter_mut()).for_each(|(c, v)| scale(*c, v));
+}
+
 /// [`select_states`] with a chosen internal candidate set.
 pub fn select_states_among(
     sys: &System,
@@ -95,7 +123,8 @@ pub fn select_states_among(
         of_tier[c.tier].push(cands.len());
         cands.push(c);
     }
-    let (fixed, nf) = constraint_rows(sys, q, t, inputs);
+    let (mut fixed, nf) = constraint_rows(sys, q, t, inputs);
+    scale_modal_columns(sys, &mut fixed, &mut tiers);
     // Sparse Gaussian elimination with complete pivoting (Eq. 33); pivots > RANK_TOL·max(largest, 1).
     let choice = choose_in_tiers(n, nf, &fixed, &tiers, RANK_TOL, false).map_err(|e| match e {
         TierError::NotFinite(e) => format!("the constraint Jacobian is not finite here ({e})"),

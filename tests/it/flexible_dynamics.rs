@@ -465,3 +465,21 @@ fn a_spring_on_a_node_marker_does_the_work_its_modes_store() {
     assert!(eta_max > 1e-4, "the spring must bend the beam: max |η| = {eta_max:e}");
     assert!(worst_p < 1e-7 && worst_e < 1e-6, "ΔP {worst_p:e}, ΔE {worst_e:e}");
 }
+
+/// The example `models/flexible/suspension.xml` (double wishbone, flexible lower arm with
+/// 8 Craig–Bampton modes): 22 constraints on 32 coordinates leave 10 degrees of freedom,
+/// all of them linearization states at its static equilibrium (the state selection scales
+/// the modal columns, without which a rank decision dropped below the true rank here);
+/// every mode is damped (Re λ < 0) and comes as a complex pair: body bounce, wheel hop,
+/// the fore-aft compliance mode of the wheel on the arm, the arm's own modes.
+#[test]
+fn the_suspension_example_linearizes_in_ten_degrees_of_freedom() {
+    let path = crate::common::model_dir().join("flexible/suspension.xml");
+    let m = mbfmu::model::load_file(&path).unwrap_or_else(|e| panic!("{e}"));
+    let lin = crate::common::lin_at_start(&m);
+    assert_eq!(lin.states.len(), 20, "{:?}", lin.states);
+    assert_eq!(&lin.states[..2], ["z_body", "z_wheel"]);
+    let ev = lin.a.eigenvalues().unwrap();
+    assert!(ev.iter().all(|z| z.re < 0.0), "{ev:?}");
+    assert_eq!(ev.iter().filter(|z| z.im > 0.0).count(), 10, "{ev:?}");
+}

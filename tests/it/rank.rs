@@ -143,8 +143,7 @@ fn example_models_constraint_jacobians_match_dense_full_pivoting() {
     // the whole pivot sequence must.
     let mut rng = Rng(0x2545_F491_4F6C_DD1D);
     let mut checked = 0;
-    for entry in std::fs::read_dir(model_dir()).unwrap() {
-        let path = entry.unwrap().path();
+    for path in crate::common::model_files() {
         let model = load_file(&path).unwrap();
         let sim = Simulator::new(&model, SimOptions::default(), 0.0).unwrap();
         let sys = sim.system();

@@ -42,6 +42,19 @@ pub fn model_files() -> Vec<PathBuf> {
     v
 }
 
+/// The example models with flexible bodies, `models/flexible/*.xml`, sorted: kept apart
+/// from [`model_files`] because their modal data files must travel with them (tests that
+/// copy a model's text elsewhere cannot take them).
+pub fn flexible_model_files() -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(model_dir().join("flexible"))
+        .expect("models/flexible/ exists")
+        .map(|e| e.expect("readable models/flexible/ entry").path())
+        .filter(|p| p.extension().is_some_and(|x| x == "xml"))
+        .collect();
+    v.sort();
+    v
+}
+
 /// The text of the example model `models/<name>`.
 pub fn model_text(name: &str) -> String {
     std::fs::read_to_string(model_dir().join(name)).unwrap()
