@@ -169,9 +169,21 @@ fn a_cantilever_linearizes_to_its_modal_frequencies() {
 /// ~1e-12·|f'''|, round-off ~1e-10 relative: 1e-6 relative to max(1, |entry|).
 #[test]
 fn a_four_bar_with_a_flexible_coupler_matches_central_differences() {
+    four_bar_against_central_differences(3, &["crank", "j2.angle", "j3.angle"]);
+}
+
+/// The same with five modes: one modal coordinate joins the states beside the joint
+/// angles (a closed loop of redundant planar revolutes whose redundancy the coupler's
+/// out-of-plane modes partly lift).
+#[test]
+fn a_four_bar_with_a_five_mode_coupler_matches_central_differences() {
+    four_bar_against_central_differences(5, &["crank", "j2.angle", "j3.angle", "coupler.eta1"]);
+}
+
+fn four_bar_against_central_differences(modes: usize, states: &[&str]) {
     use mbfmu::linearize::{linearize, select_states};
-    let data = soft_beam(3, None);
-    let dir = dir_with("fourbar", &data);
+    let data = soft_beam(modes, None);
+    let dir = dir_with(&format!("fourbar-{modes}"), &data);
     let m = load(
         &dir,
         r#"<multibody name="flexbar" version="1">
@@ -208,7 +220,7 @@ fn a_four_bar_with_a_flexible_coupler_matches_central_differences() {
     // The coupler's bending adds degrees of freedom to the rigid four-bar's one; Eq. 33
     // prefers joint coordinates, so they show as the relative angles at its ends.
     let names: Vec<&str> = sel.states.iter().map(|s| s.name.as_str()).collect();
-    assert_eq!(names, ["crank", "j2.angle", "j3.angle"]);
+    assert_eq!(names, states);
     sim.advance(0.2).unwrap();
     let lin = linearize(&mut sim, &sel, 2).unwrap();
     let (sys, q0, t, v0) = (sim.system().clone(), sim.q().to_vec(), sim.time(), sim.inputs());
