@@ -1,6 +1,8 @@
 //! Flexible-body benchmark (issue 14): simulation and linearization time of a free beam
-//! tumbling in space and of a cantilever under gravity, for 5, 20 and 30 modes (the most a body may have) and
-//! 20 vs 200 beam elements. After the inertia invariants are computed the node count
+//! tumbling in space and of a cantilever under gravity, for 5, 20 and 30 modes (the most
+//! a body may have), and of the example `models/flexible/suspension.xml` (its lower arm
+//! with 6, 12 and 24 Craig–Bampton modes: its ball joint to the knuckle may have 36 local
+//! coordinates), each with 20 vs 200 beam elements. After the inertia invariants are computed the node count
 //! must not matter: the 200/20 ratios should be ≈ 1 (the generator's eigen solve, timed
 //! apart, does grow with it).
 //! Usage: cargo run --release --example flex_bench   (bench/flexible.sh runs it)
@@ -23,6 +25,32 @@ const CANTILEVER: &str = r#"<multibody name="cantilever" version="1">
   <joint name="clamp" type="fixed" i="beam.root" j="ground.wall"/>
 </multibody>"#;
 
+/// The suspension example with its lower arm's data in `arm.json` (`elements` elements:
+/// spring seat at 3/4 of the arm, ball joint at its end) and a 1 cm road step.
+fn suspension(elements: usize) -> String {
+    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/models/flexible/suspension.xml")).unwrap();
+    text.replace("suspension_lower_arm.json", "arm.json")
+        .replace(r#"node="6""#, &format!(r#"node="{}""#, 3 * elements / 4))
+        .replace(r#"node="8""#, &format!(r#"node="{elements}""#))
+        .replace(r#"<input name="zr" start="0""#, r#"<input name="zr" start="0.01""#)
+}
+
+/// The suspension's lower arm (as in the example) with `elements` elements and `modes`
+/// Craig–Bampton modes (6 constraint modes for its two joint nodes plus fixed ones).
+fn arm(elements: usize, modes: usize) -> mbfmu::modal::ModalData {
+    beam(&BeamSpec {
+        length: 0.4,
+        elements,
+        section: Section { area: 8e-4, iy: 5e-9, iz: 1e-8, j: 6e-9 },
+        material: Material { young: 2.1e11, shear: 2.1e11 / 2.6, density: 7850.0 },
+        modes,
+        damping: Some(0.02),
+        clamp: None,
+        reduction: Reduction::CraigBampton { interface: vec![0, elements as u32], fixed_modes: modes - 6 },
+    })
+    .unwrap()
+}
+
 /// (simulation of 0.5 s, one linearization) in seconds.
 fn run(dir: &std::path::Path, text: &str) -> (f64, f64) {
     std::fs::write(dir.join("m.xml"), text).unwrap();
@@ -44,25 +72,36 @@ fn main() {
         "{:<10} {:>6} {:>9} {:>10} {:>10} {:>10}",
         "model", "modes", "elements", "generate s", "simulate s", "linearize s"
     );
-    for name in ["tumbling", "cantilever"] {
-        for modes in [5, 20, 30] {
+    for name in ["tumbling", "cantilever", "suspension"] {
+        let mode_counts = if name == "suspension" { [6, 12, 24] } else { [5, 20, 30] };
+        for modes in mode_counts {
             let mut times = Vec::new();
             for elements in [20, 200] {
                 let t = Instant::now();
-                let data = beam(&BeamSpec {
-                    length: 1.0,
-                    elements,
-                    section: Section { area: 1e-3, iy: 2e-9, iz: 1e-9, j: 3e-9 },
-                    material: Material { young: 7e9, shear: 2.7e9, density: 2700.0 },
-                    modes,
-                    damping: Some(0.01),
-                    clamp: (name == "cantilever").then_some(0),
-                    reduction: Reduction::FreeInterface,
-                })
-                .unwrap();
+                let data = if name == "suspension" {
+                    arm(elements, modes)
+                } else {
+                    beam(&BeamSpec {
+                        length: 1.0,
+                        elements,
+                        section: Section { area: 1e-3, iy: 2e-9, iz: 1e-9, j: 3e-9 },
+                        material: Material { young: 7e9, shear: 2.7e9, density: 2700.0 },
+                        modes,
+                        damping: Some(0.01),
+                        clamp: (name == "cantilever").then_some(0),
+                        reduction: Reduction::FreeInterface,
+                    })
+                    .unwrap()
+                };
                 let t_gen = t.elapsed().as_secs_f64();
-                std::fs::write(dir.join("beam.json"), write(&data)).unwrap();
-                let (ts, tl) = run(&dir, if name == "tumbling" { TUMBLING } else { CANTILEVER });
+                let file = if name == "suspension" { "arm.json" } else { "beam.json" };
+                std::fs::write(dir.join(file), write(&data)).unwrap();
+                let text = match name {
+                    "tumbling" => TUMBLING.to_string(),
+                    "cantilever" => CANTILEVER.to_string(),
+                    _ => suspension(elements),
+                };
+                let (ts, tl) = run(&dir, &text);
                 println!("{name:<10} {modes:>6} {elements:>9} {t_gen:>10.3} {ts:>10.3} {tl:>10.4}");
                 times.push((ts, tl));
             }
