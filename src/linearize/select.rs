@@ -68,19 +68,22 @@ pub fn select_states(sys: &System, q: &[f64], t: f64, inputs: &[f64]) -> Result<
     select_states_among(sys, q, t, inputs, Candidates::default())
 }
 
-/// Scale each modal-coordinate column of the selection matrix (constraint rows `fixed` and
-/// candidate rows `tiers`) to largest |entry| 1. Modal coordinates carry the data's
-/// normalization (a mass-normalized rotation shape at a light node can be hundreds of rad
-/// per unit η), which would otherwise set the rank tolerance for the rigid columns too. A
-/// column scaling is a change of units: it changes neither the rank nor which coordinates
-/// stay free; rigid models have no modal columns and are untouched.
+/// Scale down each modal-coordinate column of the selection matrix (constraint rows
+/// `fixed` and candidate rows `tiers`) whose largest |entry| exceeds one, to largest
+/// |entry| one. Modal coordinates carry the data's normalization (a mass-normalized rotation shape
+/// at a light node can be hundreds of rad per unit η), which would otherwise set the rank
+/// tolerance (relative to the largest pivot) for the rigid columns too. Columns are never
+/// scaled up: that would lift round-off (a mode's shape components of 1e-12 where it has
+/// none) to the size of real entries. A column scaling is a change of units: it changes
+/// neither the rank nor which coordinates stay free; rigid models have no modal columns
+/// and are untouched.
 fn scale_modal_columns(sys: &System, fixed: &mut [(usize, usize, f64)], tiers: &mut [Vec<CandidateRow>]) {
     let first = crate::mechanics::body::NQ * sys.nb();
     let n = sys.n();
     if first == n {
         return;
     }
-    let mut big = vec![0.0f64; n - first];
+    let mut big = vec![1.0f64; n - first];
     let rows = tiers.iter().flatten().flat_map(|r| r.entries.iter().map(|&(c, v)| (c, v)));
     for (c, v) in fixed.iter().map(|&(_, c, v)| (c, v)).chain(rows) {
         if c >= first {
@@ -88,7 +91,7 @@ fn scale_modal_columns(sys: &System, fixed: &mut [(usize, usize, f64)], tiers: &
         }
     }
     let scale = |c: usize, v: &mut f64| {
-        if c >= first && big[c - first] > 0.0 {
+        if c >= first {
             *v /= big[c - first];
         }
     };

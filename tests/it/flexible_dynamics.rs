@@ -359,34 +359,42 @@ fn a_cantilever_started_in_its_first_mode_vibrates_harmonically() {
     assert!(worst.iter().all(|&x| x < 1e-7), "{worst:?}");
 }
 
-/// User linearization states may be modal coordinates: the cantilever linearized in
-/// `modal(beam, 2)` (plus automatic states for the rest) has the same eigenvalues as in
-/// the automatic selection, ±i 2πf_k to 1e-10 relative (as above).
+/// User linearization states may be modal coordinates or node deflections: the
+/// cantilever linearized in `2 * modal(beam, 2)`, or in its tip node's lateral deflection
+/// relative to the clamped root (`dz(beam.tip, beam.root, beam.root)`), plus automatic
+/// states for the rest, has the same eigenvalues as in the automatic selection,
+/// ±i 2πf_k to 1e-10 relative (as above).
 #[test]
-fn a_cantilever_linearizes_in_a_modal_user_state() {
+fn a_cantilever_linearizes_in_a_modal_or_node_deflection_user_state() {
     let data = soft_beam(3, Some(0));
     let dir = dir_with("cantilever-user", &data);
-    let m = load(
-        &dir,
-        r#"<multibody name="cantilever" version="1">
+    let tip = data.nodes[data.nodes.len() - 1].id;
+    let mbfmu::modal::ModalStiffness::Frequencies(f) = &data.stiffness else { panic!("frequencies") };
+    for state in ["2 * modal(beam, 2)", "dz(beam.tip, beam.root, beam.root)"] {
+        let m = load(
+            &dir,
+            &format!(
+                r#"<multibody name="cantilever" version="1">
   <ground><marker name="wall" position="0 0 0"/></ground>
   <flexible_body name="beam" modal="beam.json" position="0 0 0">
     <marker name="root" node="0"/>
+    <marker name="tip" node="{tip}"/>
   </flexible_body>
   <joint name="clamp" type="fixed" i="beam.root" j="ground.wall"/>
-  <linearization><state name="second" function="2 * modal(beam, 2)"/></linearization>
+  <linearization><state name="mine" function="{state}"/></linearization>
 </multibody>
-"#,
-    );
-    let lin = crate::common::lin_at_start(&m);
-    assert_eq!(lin.states[0], "second", "{:?}", lin.states);
-    assert_eq!(lin.states.len(), 6, "{:?}", lin.states);
-    let mut im: Vec<f64> = lin.a.eigenvalues().unwrap().iter().filter(|z| z.im > 0.0).map(|z| z.im).collect();
-    im.sort_by(f64::total_cmp);
-    let mbfmu::modal::ModalStiffness::Frequencies(f) = &data.stiffness else { panic!("frequencies") };
-    for (w, f) in im.iter().zip(f) {
-        let exact = 2.0 * std::f64::consts::PI * f;
-        assert!((w - exact).abs() < 1e-10 * exact, "ω = {w} vs 2πf = {exact}");
+"#
+            ),
+        );
+        let lin = crate::common::lin_at_start(&m);
+        assert_eq!((lin.states[0].as_str(), lin.states.len()), ("mine", 6), "{state}: {:?}", lin.states);
+        let mut im: Vec<f64> = lin.a.eigenvalues().unwrap().iter().filter(|z| z.im > 0.0).map(|z| z.im).collect();
+        im.sort_by(f64::total_cmp);
+        assert_eq!(im.len(), 3, "{state}");
+        for (w, f) in im.iter().zip(f) {
+            let exact = 2.0 * std::f64::consts::PI * f;
+            assert!((w - exact).abs() < 1e-10 * exact, "{state}: ω = {w} vs 2πf = {exact}");
+        }
     }
 }
 
