@@ -20,13 +20,15 @@ FOREIGN = Path(__file__).resolve().parent / "foreign"
 
 @pytest.fixture(scope="session")
 def packed(tmp_path_factory):
-    """packed(name) -> Path of models/<name>.xml packed by `mbfmu pack` (once)."""
+    """packed(name) -> Path of models/<name>.xml packed by `mbfmu pack` (once); `name` may
+    name a subdirectory (`flexible/suspension`)."""
     cache: dict[str, Path] = {}
 
     def get(name: str) -> Path:
         if name not in cache:
-            d = tmp_path_factory.mktemp(name)
-            cache[name] = mbfmu.pack(MODELS / f"{name}.xml", d / f"{name}.fmu")
+            stem = Path(name).name
+            d = tmp_path_factory.mktemp(stem)
+            cache[name] = mbfmu.pack(MODELS / f"{name}.xml", d / f"{stem}.fmu")
         return cache[name]
 
     return get

@@ -10,7 +10,11 @@ from fmpy.fmi2 import FMU2Slave
 
 import mbfmu
 
-ALL_MODELS = sorted(p.stem for p in MODELS.glob("*.xml"))
+# The example models, those with flexible bodies (models/flexible/, with their modal data
+# files) included.
+ALL_MODELS = sorted(p.stem for p in MODELS.glob("*.xml")) + sorted(
+    f"flexible/{p.stem}" for p in (MODELS / "flexible").glob("*.xml")
+)
 
 
 @pytest.mark.parametrize("name", ALL_MODELS)

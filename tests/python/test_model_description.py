@@ -10,6 +10,7 @@ set MBFMU_BIN to use another.
 """
 
 import os
+import re
 import subprocess
 import xml.etree.ElementTree as ET
 import zipfile
@@ -20,7 +21,8 @@ from fmpy import read_model_description
 from fmpy.validation import validate_fmu
 
 ROOT = Path(__file__).resolve().parents[2]
-MODELS = sorted((ROOT / "models").glob("*.xml"))
+# The example models, those with flexible bodies (models/flexible/) included.
+MODELS = sorted((ROOT / "models").glob("*.xml")) + sorted((ROOT / "models" / "flexible").glob("*.xml"))
 
 
 def mbfmu() -> Path:
@@ -54,9 +56,17 @@ def test_packed_fmu_validates(model: Path, tmp_path: Path):
     assert md.fmiVersion == "2.0"
     assert md.coSimulation is not None and md.modelExchange is None
     identifier = md.coSimulation.modelIdentifier
+    # A flexible body's modal data file travels in resources/, under the path the model gives.
+    modal = [f"resources/{f}" for f in re.findall(r'modal="([^"]+)"', model.read_text())]
     with zipfile.ZipFile(fmu) as z:
         assert sorted(z.namelist()) == sorted(
-            ["modelDescription.xml", f"binaries/linux64/{identifier}.so", "resources/model.xml", "resources/states.txt"]
+            [
+                "modelDescription.xml",
+                f"binaries/linux64/{identifier}.so",
+                "resources/model.xml",
+                "resources/states.txt",
+                *modal,
+            ]
         )
         assert z.read("resources/model.xml") == model.read_bytes()
 
