@@ -56,7 +56,7 @@ pub enum Slot {
 impl Layout {
     /// The layout of a system's equations.
     pub fn of(sys: &System) -> Layout {
-        let (n, body_cols, acc_rigid) = (sys.n(), NQ * sys.nb(), NQ * sys.acc_bodies.len());
+        let (n, body_cols, acc_rigid) = (sys.n(), sys.modal_columns().start, NQ * sys.acc_bodies.len());
         Layout { n, m: sys.m, nx: sys.nx, nv: sys.nv, mn: sys.mn, na: acc_rigid + n - body_cols, body_cols, acc_rigid }
     }
     /// Number of user unknowns Z = (X, Ẋ, V, a).

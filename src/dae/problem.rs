@@ -95,7 +95,7 @@ impl MultibodyDae {
             let ids: Vec<usize> = (0..sys.nb()).collect();
             type D1 = crate::ad::Dual<f64, 1>;
             let mut qd: Vec<D1> = Vec::with_capacity(q.len());
-            let body_cols = NQ * sys.nb();
+            let body_cols = sys.modal_columns().start;
             for (qb, ub) in q[..body_cols].chunks_exact(NQ).zip(u[..body_cols].chunks_exact(NQ)) {
                 let rate = crate::mechanics::body::qdot(qb, ub);
                 qd.extend(qb.iter().zip(rate).map(|(&v, d)| D1 { v, d: [d] }));

@@ -46,7 +46,7 @@ pub fn rhs(sys: &System, lay: Layout, t: f64, y: &[f64], inputs: &[f64], f: &mut
         let o = NQ * b;
         f[o..o + NQ].copy_from_slice(&qdot(&q[o..o + NQ], &u[o..o + NQ])); // Eq. 13b
     }
-    let modal = NQ * sys.nb()..lay.n;
+    let modal = sys.modal_columns();
     f[modal.clone()].copy_from_slice(&u[modal]); // η̇ = u_η
     applied_forces(sys, q, u, t, &ext, &mut f[lay.u_range()]);
     nonholonomic_rows(sys, lay, t, y, &ext, f);

@@ -78,12 +78,11 @@ pub fn select_states(sys: &System, q: &[f64], t: f64, inputs: &[f64]) -> Result<
 /// neither the rank nor which coordinates stay free; rigid models have no modal columns
 /// and are untouched.
 fn scale_modal_columns(sys: &System, fixed: &mut [(usize, usize, f64)], tiers: &mut [Vec<CandidateRow>]) {
-    let first = crate::mechanics::body::NQ * sys.nb();
-    let n = sys.n();
-    if first == n {
+    let modal = sys.modal_columns();
+    if modal.is_empty() {
         return;
     }
-    let mut big = vec![1.0f64; n - first];
+    let (first, mut big) = (modal.start, vec![1.0f64; modal.len()]);
     let rows = tiers.iter().flatten().flat_map(|r| r.entries.iter().map(|&(c, v)| (c, v)));
     for (c, v) in fixed.iter().map(|&(_, c, v)| (c, v)).chain(rows) {
         if c >= first {

@@ -21,7 +21,7 @@ use std::collections::BTreeMap;
 /// A sparse u-space row (global columns, any order, repeated columns summed) as the same
 /// linear form in q̇ (times T(q)): sorted by column, zeros left out.
 fn qdot_row(sys: &System, q: &[f64], entries: impl IntoIterator<Item = (usize, f64)>) -> Vec<(usize, f64)> {
-    let body_cols = NQ * sys.nb();
+    let body_cols = sys.modal_columns().start;
     let mut by_body: BTreeMap<usize, [f64; NQ]> = BTreeMap::new();
     let mut modal: BTreeMap<usize, f64> = BTreeMap::new(); // T = I for modal velocities
     for (c, v) in entries {

@@ -41,7 +41,7 @@ pub fn p_row(bodies: &[usize], q: &[f64], cq: &[f64]) -> Vec<f64> {
 /// external values.
 pub fn constraint_rows(sys: &System, els: &[ConstraintEl], q: &[f64], t: f64, ext: &[f64]) -> ConstraintRows {
     let nrows = els.iter().map(|e| e.row + e.neq).max().unwrap_or(0);
-    let body_cols = NQ * sys.nb();
+    let body_cols = sys.modal_columns().start;
     let mut out = ConstraintRows { c: vec![0.0; nrows], ct: vec![0.0; nrows], entries: Vec::new(), body_cols };
     for el in els {
         let f = constraint_first(sys, el, q, t, ext);

@@ -143,7 +143,7 @@ impl ExtLayout {
 impl System {
     /// Layout of the external values this system's elements read.
     pub fn ext_layout(&self) -> ExtLayout {
-        let neta = self.n() - NQ * self.nb();
+        let neta = self.modal_columns().len();
         ExtLayout::new(self.input_names.len(), self.nx, self.nv, self.acc_bodies.len(), neta, self.load_refs.len())
     }
     /// Number of inputs.

@@ -246,12 +246,9 @@ impl<T: Real> ExprEnv<T> for LocalCtx<'_, T> {
     /// η_k or η̇_k of the body marker `m` is on (NaN for a rigid body or ground; the
     /// parser only lets flexible bodies' modes through).
     fn modal(&self, f: ModalFn, m: MarkerId, k: usize) -> T {
-        let level = match f {
-            ModalFn::Coordinate => 0,
-            ModalFn::Rate => 1,
-        };
+        // self.modal[l] holds η, η̇, η̈: indexed by the measure's derivative level.
         let local = self.sys.markers[m].body.map(|b| self.local(b));
-        local.and_then(|l| self.modal[l][level].get(k).copied()).unwrap_or(T::cst(f64::NAN))
+        local.and_then(|l| self.modal[l][usize::from(f.level())].get(k).copied()).unwrap_or(T::cst(f64::NAN))
     }
     /// Angles stay on the branch nearest their value at the last accepted step.
     fn unwrap_angle(&self, slot: usize, a: T) -> T {

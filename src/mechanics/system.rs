@@ -191,6 +191,12 @@ impl System {
         self.flex.iter().find(|f| f.body == b)
     }
 
+    /// Where the modal coordinates of all flexible bodies sit in q (and u): after the six of
+    /// every body, up to n (empty without flexible bodies).
+    pub fn modal_columns(&self) -> std::ops::Range<usize> {
+        NQ * self.bodies.len()..self.n()
+    }
+
     /// Where body `b`'s modal coordinates sit in q (empty for a rigid body).
     pub fn modal_range(&self, b: usize) -> std::ops::Range<usize> {
         self.flex.iter().find(|f| f.body == b).map_or(0..0, |f| f.eta.clone())
