@@ -144,19 +144,22 @@ def reference():
     res += sp.Matrix([sp.diff(pot, a) for a in q]) - q_gen
 
     point = dict(zip(list(q) + list(qd) + [f, h], [TH0, *ETA0, W0, *ETAD0, F0, H0], strict=True))
-    num = lambda e: np.array(sp.lambdify(list(point), e, "numpy")(*point.values()), dtype=float)  # noqa: E731
-    m0 = num(mass)
-    acc = np.linalg.solve(m0, -num(res.subs(dict.fromkeys(qdd, 0))).ravel())
+
+    def value(e, subs):
+        """The expression `e` evaluated (double precision) at the symbol values `subs`."""
+        return np.array(sp.lambdify(list(subs), e, "numpy")(*subs.values()), dtype=float)
+
+    m0 = value(mass, point)
+    acc = np.linalg.solve(m0, -value(res.subs(dict.fromkeys(qdd, 0)), point).ravel())
     at = {**point, **dict(zip(qdd, acc, strict=True))}
-    numa = lambda e: np.array(sp.lambdify(list(at), e, "numpy")(*at.values()), dtype=float)  # noqa: E731
     a = np.zeros((2 * n, 2 * n))
     a[:n, n:] = np.eye(n)
-    a[n:, :n] = -np.linalg.solve(m0, numa(res.jacobian(q)))
-    a[n:, n:] = -np.linalg.solve(m0, numa(res.jacobian(qd)))
+    a[n:, :n] = -np.linalg.solve(m0, value(res.jacobian(q), at))
+    a[n:, n:] = -np.linalg.solve(m0, value(res.jacobian(qd), at))
     b = np.zeros((2 * n, 2))
-    b[n:, :] = -np.linalg.solve(m0, numa(res.jacobian(sp.Matrix([f, h]))))
+    b[n:, :] = -np.linalg.solve(m0, value(res.jacobian(sp.Matrix([f, h])), at))
     c = np.zeros((1, 2 * n))
-    c[:, :n] = num(sp.Matrix([x_tip[1]]).jacobian(q))
+    c[:, :n] = value(sp.Matrix([x_tip[1]]).jacobian(q), point)
     return a, b, c, np.zeros((1, 2))
 
 

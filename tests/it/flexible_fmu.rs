@@ -8,7 +8,7 @@ use mbfmu::dae::{SimOptions, Simulator};
 use mbfmu::fmi::exports_common::*;
 use mbfmu::fmi::exports_cs::*;
 use mbfmu::fmi::types::{CO_SIMULATION, Status};
-use mbfmu::modal::{BeamSpec, Material, Reduction, Section, beam, write};
+use mbfmu::modal::{BeamSpec, Material, ModalData, Reduction, Section, beam, write};
 use std::ffi::CString;
 
 /// A cantilever (4 modes, node 0 clamped) with a lateral force input at its tip and the
@@ -28,19 +28,25 @@ const MODEL: &str = r#"<multibody name="flexcant" version="1">
 </multibody>
 "#;
 
-#[test]
-fn the_fmu_of_a_flexible_model_carries_its_data_and_linearizes_like_the_engine() {
-    let data = beam(&BeamSpec {
+/// The cantilever's beam: 0.6 m, 6 elements, node 0 clamped, `modes` modes with damping
+/// ratio `damping`.
+fn cantilever_beam(modes: usize, damping: Option<f64>) -> ModalData {
+    beam(&BeamSpec {
         length: 0.6,
         elements: 6,
         section: Section { area: 1e-3, iy: 2e-9, iz: 1e-9, j: 3e-9 },
         material: Material { young: 7e9, shear: 2.7e9, density: 2700.0 },
-        modes: 4,
-        damping: Some(0.02),
+        modes,
+        damping,
         clamp: Some(0),
         reduction: Reduction::FreeInterface,
     })
-    .unwrap();
+    .unwrap()
+}
+
+#[test]
+fn the_fmu_of_a_flexible_model_carries_its_data_and_linearizes_like_the_engine() {
+    let data = cantilever_beam(4, Some(0.02));
     let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("flexible-fmu");
     std::fs::create_dir_all(dir.join("data")).unwrap();
     let json = write(&data);
@@ -136,17 +142,7 @@ fn the_fmu_of_a_flexible_model_carries_its_data_and_linearizes_like_the_engine()
 /// refuses it at the element (exit code 2, `file:line:col`) and writes nothing.
 #[test]
 fn pack_refuses_modal_data_outside_the_model_directory() {
-    let data = beam(&BeamSpec {
-        length: 0.6,
-        elements: 6,
-        section: Section { area: 1e-3, iy: 2e-9, iz: 1e-9, j: 3e-9 },
-        material: Material { young: 7e9, shear: 2.7e9, density: 2700.0 },
-        modes: 2,
-        damping: None,
-        clamp: Some(0),
-        reduction: Reduction::FreeInterface,
-    })
-    .unwrap();
+    let data = cantilever_beam(2, None);
     let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("flexible-fmu-outside");
     std::fs::create_dir_all(&dir).unwrap();
     let data_path = dir.join("beam.json");
@@ -172,16 +168,6 @@ fn pack_refuses_modal_data_outside_the_model_directory() {
 /// differently (whitespace) keep it.
 #[test]
 fn the_guid_changes_with_the_modal_data_values() {
-    let spec = |damping| BeamSpec {
-        length: 0.6,
-        elements: 6,
-        section: Section { area: 1e-3, iy: 2e-9, iz: 1e-9, j: 3e-9 },
-        material: Material { young: 7e9, shear: 2.7e9, density: 2700.0 },
-        modes: 2,
-        damping,
-        clamp: Some(0),
-        reduction: Reduction::FreeInterface,
-    };
     let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("flexible-fmu-guid");
     std::fs::create_dir_all(dir.join("data")).unwrap();
     let label = dir.join("m.xml").display().to_string();
@@ -190,8 +176,8 @@ fn the_guid_changes_with_the_modal_data_values() {
         let m = mbfmu::model::load_str(MODEL, &label).unwrap_or_else(|e| panic!("{e}"));
         mbfmu::fmi::guid::guid(&m, MODEL)
     };
-    let json = write(&beam(&spec(Some(0.02))).unwrap());
+    let json = write(&cantilever_beam(2, Some(0.02)));
     let g = guid_with(&json);
     assert_eq!(g, guid_with(&json.replace('\n', "\n  ")));
-    assert_ne!(g, guid_with(&write(&beam(&spec(Some(0.03))).unwrap())));
+    assert_ne!(g, guid_with(&write(&cantilever_beam(2, Some(0.03)))));
 }
