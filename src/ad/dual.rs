@@ -124,6 +124,13 @@ impl<T: Real, const N: usize> Real for Dual<T, N> {
         }
         Dual { v: self.v.scale(s), d }
     }
+    #[inline]
+    fn add_scaled(&mut self, x: &Self, s: f64) {
+        self.v.add_scaled(&x.v, s);
+        for (a, b) in self.d.iter_mut().zip(&x.d) {
+            a.add_scaled(b, s);
+        }
+    }
     fn sin(self) -> Self {
         self.chain(self.v.sin(), self.v.cos())
     }

@@ -23,6 +23,11 @@ pub trait Real:
     fn val(&self) -> f64;
     /// Multiply by a plain number.
     fn scale(self, s: f64) -> Self;
+    /// `self += x·s` for a plain number `s`, in place (no temporaries: the modal sums
+    /// of flexible bodies run over many wide dual numbers).
+    fn add_scaled(&mut self, x: &Self, s: f64) {
+        *self += x.scale(s);
+    }
     fn sin(self) -> Self;
     fn cos(self) -> Self;
     fn tan(self) -> Self;

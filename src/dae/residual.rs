@@ -7,7 +7,7 @@ use crate::mechanics::body::{NQ, qdot};
 use crate::mechanics::constraint_jacobian::constraint_jacobian;
 use crate::mechanics::coords::{gather, global_column};
 use crate::mechanics::flexible;
-use crate::mechanics::kernels::{force_values, gyroscopic, nonholonomic_second, user_residual};
+use crate::mechanics::kernels::{force_values, gyroscopic, nonholonomic_first, user_residual};
 use crate::mechanics::mass::body_mass_times;
 
 /// Applied generalized forces Q(u, q, t): gravity, gyroscopic terms and force elements.
@@ -68,7 +68,7 @@ fn user_rows(sys: &System, lay: Layout, t: f64, y: &[f64], ext: &[f64], f: &mut 
 fn nonholonomic_rows(sys: &System, lay: Layout, t: f64, y: &[f64], ext: &[f64], f: &mut [f64]) {
     let (q, u, nu, nn) = (&y[lay.q_range()], &y[lay.u_range()], lay.u(), lay.nu());
     for el in &sys.nonholonomic {
-        let s = nonholonomic_second(sys, el, q, u, t, ext);
+        let s = nonholonomic_first(sys, el, q, u, t, ext);
         let nql = crate::mechanics::coords::nql(sys, &el.bodies);
         for e in 0..el.neq {
             let nu_e = y[nn + el.row + e];

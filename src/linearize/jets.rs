@@ -7,12 +7,14 @@
 //! nested dual numbers (q̇ = H u, q̈ = d(Hu)/dt), whose base scalar is itself a dual
 //! number seeded on (q, u, u̇, t).
 
+use crate::ad::chunked::{by_width, seed, seed_one};
 use crate::ad::{Dual, Real};
 use crate::mechanics::System;
 use crate::mechanics::body::{NQ, qdot};
 use crate::mechanics::constraints::ConstraintEl;
 use crate::mechanics::coords::{gather, nql};
 use crate::mechanics::local::LocalCtx;
+use std::ops::Range;
 
 /// A function of body poses and time, evaluated generically.
 pub trait PositionFn {
@@ -85,35 +87,33 @@ pub fn jets<F: PositionFn>(
     inputs: &[f64],
 ) -> Vec<Jet> {
     // q, u and u̇ of every local coordinate, and t.
-    match 3 * nql(sys, f.bodies()) + 1 {
-        1 => jets_k::<1, F>(sys, f, q, u, udot, t, inputs),
-        2..=19 => jets_k::<19, F>(sys, f, q, u, udot, t, inputs),
-        20..=37 => jets_k::<37, F>(sys, f, q, u, udot, t, inputs),
-        38..=55 => jets_k::<55, F>(sys, f, q, u, udot, t, inputs),
-        56..=73 => jets_k::<73, F>(sys, f, q, u, udot, t, inputs),
-        74..=91 => jets_k::<91, F>(sys, f, q, u, udot, t, inputs),
-        _ => jets_k::<109, F>(sys, f, q, u, udot, t, inputs),
-    }
+    let k = 3 * nql(sys, f.bodies()) + 1;
+    let zero = Jet { g: 0.0, g1: 0.0, g2: 0.0, dg: vec![0.0; k], dg1: vec![0.0; k], dg2: vec![0.0; k] };
+    let mut out = vec![zero; f.components()];
+    by_width!(k, jets_k, [1, 19, 37, 55, 73, 91, 109](sys, f, q, u, udot, t, inputs, &mut out));
+    out
 }
 
-fn jets_k<const K: usize, F: PositionFn>(
+/// The columns `chunk` of z = (q, u, u̇, t) of [`jets`].
+#[allow(clippy::too_many_arguments)]
+fn jets_k<const K: usize>(
     sys: &System,
-    f: &F,
+    f: &impl PositionFn,
     q: &[f64],
     u: &[f64],
     udot: &[f64],
     t: f64,
     inputs: &[f64],
-) -> Vec<Jet> {
+    jets: &mut [Jet],
+    chunk: Range<usize>,
+) {
     type B<const K: usize> = Dual<f64, K>;
     let bodies = f.bodies();
     let nq = nql(sys, bodies);
-    let seed =
-        |x: Vec<f64>, off: usize| -> Vec<B<K>> { x.iter().enumerate().map(|(i, &v)| B::var(v, off + i)).collect() };
-    let qb = seed(gather(sys, bodies, q), 0);
-    let ub = seed(gather(sys, bodies, u), nq);
-    let ab = seed(gather(sys, bodies, udot), 2 * nq);
-    let tb = B::<K>::var(t, 3 * nq);
+    let qb: Vec<B<K>> = seed(&gather(sys, bodies, q), 0, &chunk);
+    let ub: Vec<B<K>> = seed(&gather(sys, bodies, u), nq, &chunk);
+    let ab: Vec<B<K>> = seed(&gather(sys, bodies, udot), 2 * nq, &chunk);
+    let tb: B<K> = seed_one(t, 3 * nq, &chunk);
     let mut qj = Vec::with_capacity(nq);
     let uj: Vec<_> =
         if f.reads_velocities() { ub.iter().zip(&ab).map(|(&v, &d)| jet(v, d, B::zero())).collect() } else { vec![] };
@@ -136,17 +136,13 @@ fn jets_k<const K: usize, F: PositionFn>(
     let ctx = LocalCtx::new(sys, bodies, &qj, &uj, &[], tj, inputs);
     let mut out = vec![Dual::zero(); f.components()];
     f.eval(&ctx, &mut out);
-    let kk = 3 * nq + 1;
-    out.iter()
-        .map(|o| Jet {
-            g: o.v.v.v,
-            g1: o.v.d[0].v,
-            g2: o.d[0].d[0].v,
-            dg: o.v.v.d[..kk].to_vec(),
-            dg1: o.v.d[0].d[..kk].to_vec(),
-            dg2: o.d[0].d[0].d[..kk].to_vec(),
-        })
-        .collect()
+    for (j, o) in jets.iter_mut().zip(&out) {
+        (j.g, j.g1, j.g2) = (o.v.v.v, o.v.d[0].v, o.d[0].d[0].v);
+        for z in chunk.clone() {
+            let c = z - chunk.start;
+            (j.dg[z], j.dg1[z], j.dg2[z]) = (o.v.v.d[c], o.v.d[0].d[c], o.d[0].d[0].d[c]);
+        }
+    }
 }
 
 /// x(τ) = x0 + τ x1 + τ²/2 x2 as nested duals: first and second τ-derivatives exact.

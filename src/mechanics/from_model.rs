@@ -7,11 +7,9 @@
 
 use super::body::{FAR_FROM_SINGULAR, NQ, rebased_reference};
 use super::constraints::{ConstraintEl, ConstraintKind, VelocityIc};
-use super::coords::nql;
 use super::external::ExtLayout;
 use super::forces::{ForceEl, ForceKind};
 use super::joint_coords::{JointCoord, joint_coordinates};
-use super::kernels::MAX_LOCAL;
 use super::nonholonomic::{NonholonomicEl, NonholonomicKind};
 use super::system::{BodyProps, FlexBody, MarkerGeom, NodeShape, System};
 use super::user::{UserEq, UserKind};
@@ -539,49 +537,8 @@ fn check_elements(
     Ok(())
 }
 
-/// Elements touching flexible bodies: at most [`MAX_LOCAL`] local coordinates each (six
-/// per body, plus the modal ones; [`nql`]), a flexible body at most `MAX_LOCAL − 6` modes,
-/// and no force or user row reads a flexible body's accelerations.
+/// No force or user row reads a flexible body's accelerations.
 fn check_flexible(model: &Model, sys: &System) -> Result<(), String> {
-    if sys.flex.is_empty() {
-        return Ok(());
-    }
-    if let Some(f) = sys.flex.iter().find(|f| NQ + f.eta.len() > MAX_LOCAL) {
-        return Err(format!(
-            "flexible body '{}' has {} modes (at most {}: its six coordinates and its modes must fit \
-             the widest dual number, {MAX_LOCAL})",
-            model.bodies[f.body].name,
-            f.eta.len(),
-            MAX_LOCAL - NQ
-        ));
-    }
-    let too_many = |what: &str, name: &str, bodies: &[usize]| {
-        let n = nql(sys, bodies);
-        (n > MAX_LOCAL).then(|| {
-            format!(
-                "{what} '{name}' has {n} coordinates (six per body it touches plus the modal ones; at most \
-                 {MAX_LOCAL}): use fewer modes"
-            )
-        })
-    };
-    let lin_exprs: Vec<(&str, Vec<usize>)> = sys
-        .lin_states
-        .iter()
-        .chain(&sys.lin_velocities)
-        .map(|(name, e, _)| (name.as_str(), bodies_of(&sys.markers, &[], &[e])))
-        .collect();
-    let checks = sys
-        .constraints
-        .iter()
-        .chain(&sys.ic_constraints)
-        .map(|c| too_many("constraint", &c.name, &c.bodies))
-        .chain(sys.forces.iter().map(|f| too_many("force", &f.name, &f.bodies)))
-        .chain(sys.nonholonomic.iter().map(|c| too_many("constraint", &c.name, &c.bodies)))
-        .chain(sys.user.iter().map(|u| too_many("user element", &u.name, &u.bodies)))
-        .chain(lin_exprs.iter().map(|(name, bodies)| too_many("linearization state", name, bodies)));
-    if let Some(e) = checks.flatten().next() {
-        return Err(e);
-    }
     for e in force_and_user_exprs(model) {
         let d = deps(e);
         let flexible = d.markers.iter().filter_map(|&m| sys.markers[m].body).find(|&b| sys.flex_of(b).is_some());

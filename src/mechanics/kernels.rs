@@ -10,7 +10,9 @@ use super::local::LocalCtx;
 use super::nonholonomic::NonholonomicEl;
 use super::system::System;
 use super::user::UserEq;
+use crate::ad::chunked::{by_width, chunks, seed, seed_one};
 use crate::ad::{Dual, Real};
+use std::ops::Range;
 
 /// C, C_q (local, row-major neq × 6nb) and C_t of one constraint element.
 pub struct ConstraintFirst {
@@ -34,26 +36,6 @@ pub struct ConstraintSecond {
     pub hess: Vec<f64>,
 }
 
-/// Call `f::<K>` with the smallest width K of the list that holds `n` variables (the
-/// list ends at the widest the model reader allows: [`MAX_LOCAL`] local coordinates).
-macro_rules! by_width {
-    ($n:expr, $f:ident, [$($k:literal),+] ( $($a:expr),* )) => {{
-        let n: usize = $n;
-        by_width!(@go n, $f, [$($k),+] ($($a),*))
-    }};
-    (@go $n:ident, $f:ident, [$k:literal] ( $($a:expr),* )) => {{
-        assert!($n <= $k, "{} variables exceed the widest dual number ({})", $n, $k);
-        $f::<$k>($($a),*)
-    }};
-    (@go $n:ident, $f:ident, [$k:literal, $($rest:literal),+] ( $($a:expr),* )) => {
-        if $n <= $k { $f::<$k>($($a),*) } else { by_width!(@go $n, $f, [$($rest),+] ($($a),*)) }
-    };
-}
-
-/// The most local coordinates an element may have (six per body it touches, plus the
-/// modal coordinates of the flexible ones): the widest dual numbers are built for it.
-pub const MAX_LOCAL: usize = 36;
-
 /// Constraint values only.
 pub fn constraint_values(sys: &System, el: &ConstraintEl, q: &[f64], t: f64, inputs: &[f64]) -> Vec<f64> {
     let ql = gather(sys, &el.bodies, q);
@@ -65,49 +47,125 @@ pub fn constraint_values(sys: &System, el: &ConstraintEl, q: &[f64], t: f64, inp
 
 /// First derivatives of a constraint element (Eq. 1b: C_q, C_t).
 pub fn constraint_first(sys: &System, el: &ConstraintEl, q: &[f64], t: f64, inputs: &[f64]) -> ConstraintFirst {
-    by_width!(nql(sys, &el.bodies) + 1, first_k, [1, 7, 13, 19, 25, 31, 37](sys, el, q, t, inputs))
+    let nq = nql(sys, &el.bodies);
+    let mut r = ConstraintFirst { c: vec![0.0; el.neq], cq: vec![0.0; el.neq * nq], ct: vec![0.0; el.neq] };
+    by_width!(nq + 1, first_k, [1, 7, 13, 19, 25, 31, 37](sys, el, q, t, inputs, &mut r));
+    r
 }
 
-fn first_k<const K: usize>(sys: &System, el: &ConstraintEl, q: &[f64], t: f64, inputs: &[f64]) -> ConstraintFirst {
+/// The columns `chunk` of z = (local q, t) of [`constraint_first`].
+fn first_k<const K: usize>(
+    sys: &System,
+    el: &ConstraintEl,
+    q: &[f64],
+    t: f64,
+    inputs: &[f64],
+    r: &mut ConstraintFirst,
+    chunk: Range<usize>,
+) {
     let nq = nql(sys, &el.bodies);
-    let ql: Vec<Dual<f64, K>> = gather(sys, &el.bodies, q).iter().enumerate().map(|(k, &v)| Dual::var(v, k)).collect();
-    let ctx = LocalCtx::new(sys, &el.bodies, &ql, &[], &[], Dual::var(t, nq), inputs);
+    let ql: Vec<Dual<f64, K>> = seed(&gather(sys, &el.bodies, q), 0, &chunk);
+    let ctx = LocalCtx::new(sys, &el.bodies, &ql, &[], &[], seed_one(t, nq, &chunk), inputs);
     let mut out = vec![Dual::zero(); el.neq];
     el.kind.eval(&ctx, &mut out);
-    let mut r = ConstraintFirst { c: vec![], cq: Vec::with_capacity(el.neq * nq), ct: vec![] };
-    for e in &out {
-        r.c.push(e.v);
-        r.cq.extend_from_slice(&e.d[..nq]);
-        r.ct.push(e.d[nq]);
+    for (e, o) in out.iter().enumerate() {
+        r.c[e] = o.v;
+        for z in chunk.clone() {
+            let d = o.d[z - chunk.start];
+            if z < nq { r.cq[e * nq + z] = d } else { r.ct[e] = d }
+        }
     }
-    r
 }
 
 /// Second derivatives of a constraint element (for Ċ_q, (Pᵀλ)_q and the γ of Eq. 1c).
 pub fn constraint_second(sys: &System, el: &ConstraintEl, q: &[f64], t: f64, inputs: &[f64]) -> ConstraintSecond {
-    by_width!(nql(sys, &el.bodies) + 1, second_k, [1, 7, 13, 19, 25, 31, 37](sys, el, q, t, inputs))
+    let k = nql(sys, &el.bodies) + 1;
+    let mut r =
+        ConstraintSecond { k, c: vec![0.0; el.neq], grad: vec![0.0; el.neq * k], hess: vec![0.0; el.neq * k * k] };
+    by_width!(k, second_k, [1, 7, 13, 19](sys, el, q, t, inputs, &mut r));
+    r
 }
 
-fn second_k<const K: usize>(sys: &System, el: &ConstraintEl, q: &[f64], t: f64, inputs: &[f64]) -> ConstraintSecond {
-    let nq = nql(sys, &el.bodies);
-    let k = nq + 1;
-    let seed = |v: f64, i: usize| Dual::<Dual<f64, K>, K> {
-        v: Dual::var(v, i),
-        d: std::array::from_fn(|j| if j == i { Dual::one() } else { Dual::zero() }),
-    };
-    let ql: Vec<_> = gather(sys, &el.bodies, q).iter().enumerate().map(|(i, &v)| seed(v, i)).collect();
-    let ctx = LocalCtx::new(sys, &el.bodies, &ql, &[], &[], seed(t, nq), inputs);
-    let mut out = vec![Dual::zero(); el.neq];
-    el.kind.eval(&ctx, &mut out);
-    let mut r = ConstraintSecond { k, c: vec![], grad: vec![], hess: vec![] };
-    for e in &out {
-        r.c.push(e.v.v);
-        r.grad.extend(e.v.d[..k].iter().copied());
-        for a in 0..k {
-            r.hess.extend(e.d[a].d[..k].iter().copied());
+/// The rows `outer` of the Hessians of [`constraint_second`] (and the gradient): nested
+/// duals, the outer level seeded on `outer`, the inner on each chunk of z from `outer`
+/// on (the Hessian is symmetric: each block is written to both of its places).
+fn second_k<const K: usize>(
+    sys: &System,
+    el: &ConstraintEl,
+    q: &[f64],
+    t: f64,
+    inputs: &[f64],
+    r: &mut ConstraintSecond,
+    outer: Range<usize>,
+) {
+    let (nq, k) = (nql(sys, &el.bodies), r.k);
+    let z: Vec<f64> = gather(sys, &el.bodies, q).into_iter().chain([t]).collect();
+    for inner in chunks(k, K).filter(|c| c.end > outer.start) {
+        let zd: Vec<Dual<Dual<f64, K>, K>> = z
+            .iter()
+            .enumerate()
+            .map(|(i, &v)| Dual {
+                v: seed_one(v, i, &inner),
+                d: std::array::from_fn(|j| if outer.start + j == i { Dual::one() } else { Dual::zero() }),
+            })
+            .collect();
+        let ctx = LocalCtx::new(sys, &el.bodies, &zd[..nq], &[], &[], zd[nq], inputs);
+        let mut out = vec![Dual::zero(); el.neq];
+        el.kind.eval(&ctx, &mut out);
+        for (e, o) in out.iter().enumerate() {
+            r.c[e] = o.v.v;
+            let h = &mut r.hess[e * k * k..(e + 1) * k * k];
+            for b in inner.clone() {
+                r.grad[e * k + b] = o.v.d[b - inner.start];
+                for a in outer.clone() {
+                    let x = o.d[a - outer.start].d[b - inner.start];
+                    h[a * k + b] = x;
+                    h[b * k + a] = x;
+                }
+            }
         }
     }
+}
+
+/// g of a non-holonomic element with its gradient over z = (local q, local u, t).
+pub struct NonholonomicFirst {
+    /// Number K = 2nq + 1 of variables z.
+    pub k: usize,
+    /// g (neq).
+    pub c: Vec<f64>,
+    /// neq × K.
+    pub grad: Vec<f64>,
+}
+
+/// g and ∂g/∂(q, u, t) of a non-holonomic element: B and γ need no more.
+pub fn nonholonomic_first(
+    sys: &System,
+    el: &NonholonomicEl,
+    q: &[f64],
+    u: &[f64],
+    t: f64,
+    ext: &[f64],
+) -> NonholonomicFirst {
+    let k = 2 * nql(sys, &el.bodies) + 1;
+    let mut r = NonholonomicFirst { k, c: vec![0.0; el.neq], grad: vec![0.0; el.neq * k] };
+    by_width!(k, nh_first_k, [1, 13, 25, 37, 49, 61, 73]((sys, el, q, u, t, ext), &mut r));
     r
+}
+
+/// The columns `chunk` of [`nonholonomic_first`].
+fn nh_first_k<const K: usize>((sys, el, q, u, t, ext): NhArgs, r: &mut NonholonomicFirst, chunk: Range<usize>) {
+    let nq = nql(sys, &el.bodies);
+    let ql: Vec<Dual<f64, K>> = seed(&gather(sys, &el.bodies, q), 0, &chunk);
+    let ul: Vec<Dual<f64, K>> = seed(&gather(sys, &el.bodies, u), nq, &chunk);
+    let ctx = LocalCtx::new(sys, &el.bodies, &ql, &ul, &[], seed_one(t, 2 * nq, &chunk), ext);
+    let mut out = vec![Dual::zero(); el.neq];
+    el.kind.eval(&ctx, &mut out);
+    for (e, o) in out.iter().enumerate() {
+        r.c[e] = o.v;
+        for z in chunk.clone() {
+            r.grad[e * r.k + z] = o.d[z - chunk.start];
+        }
+    }
 }
 
 /// g of a non-holonomic element with its gradient over z = (local q, local u, t) and the
@@ -122,69 +180,78 @@ pub fn nonholonomic_second(
     t: f64,
     ext: &[f64],
 ) -> ConstraintSecond {
-    match nql(sys, &el.bodies) {
-        0 => nh_second_k::<1, 1>(sys, el, q, u, t, ext),
-        1..=6 => nh_second_k::<7, 6>(sys, el, q, u, t, ext),
-        7..=12 => nh_second_k::<13, 12>(sys, el, q, u, t, ext),
-        13..=18 => nh_second_k::<19, 18>(sys, el, q, u, t, ext),
-        19..=24 => nh_second_k::<25, 24>(sys, el, q, u, t, ext),
-        25..=30 => nh_second_k::<31, 30>(sys, el, q, u, t, ext),
-        _ => nh_second_k::<37, 36>(sys, el, q, u, t, ext),
+    let nq = nql(sys, &el.bodies);
+    let k = 2 * nq + 1;
+    let mut r =
+        ConstraintSecond { k, c: vec![0.0; el.neq], grad: vec![0.0; el.neq * k], hess: vec![0.0; el.neq * k * k] };
+    let mut go = |f: fn(NhArgs, &mut ConstraintSecond, Range<usize>, Range<usize>), w: usize| {
+        for cu in chunks(nq, w) {
+            for cq in chunks(nq + 1, w + 1) {
+                f((sys, el, q, u, t, ext), &mut r, cu.clone(), cq);
+            }
+        }
+    };
+    match nq {
+        0 => go(nh_second_k::<1, 1>, 1),
+        1..=6 => go(nh_second_k::<7, 6>, 6),
+        7..=12 => go(nh_second_k::<13, 12>, 12),
+        _ => go(nh_second_k::<19, 18>, 18),
     }
+    r
 }
+
+/// The arguments of [`nonholonomic_second`].
+type NhArgs<'a> = (&'a System, &'a NonholonomicEl, &'a [f64], &'a [f64], f64, &'a [f64]);
 
 /// A nested dual constant in the outer variables.
 fn outer_cst<const KQ: usize, const KU: usize>(v: Dual<f64, KQ>) -> Dual<Dual<f64, KQ>, KU> {
     Dual { v, d: [Dual::zero(); KU] }
 }
 
+/// The part of [`nonholonomic_second`] from the u in `cu` (outer duals) and the (q, t) in
+/// `cq` (inner duals; t is variable nq).
 fn nh_second_k<const KQ: usize, const KU: usize>(
-    sys: &System,
-    el: &NonholonomicEl,
-    q: &[f64],
-    u: &[f64],
-    t: f64,
-    ext: &[f64],
-) -> ConstraintSecond {
+    (sys, el, q, u, t, ext): NhArgs,
+    r: &mut ConstraintSecond,
+    cu: Range<usize>,
+    cq: Range<usize>,
+) {
     let nq = nql(sys, &el.bodies);
-    let k = 2 * nq + 1;
+    let k = r.k;
     type D2<const KQ: usize, const KU: usize> = Dual<Dual<f64, KQ>, KU>;
-    let ql: Vec<D2<KQ, KU>> =
-        gather(sys, &el.bodies, q).iter().enumerate().map(|(i, &v)| outer_cst(Dual::var(v, i))).collect();
+    let ql: Vec<D2<KQ, KU>> = seed(&gather(sys, &el.bodies, q), 0, &cq).into_iter().map(outer_cst).collect();
     let ul: Vec<D2<KQ, KU>> = gather(sys, &el.bodies, u)
         .iter()
         .enumerate()
         .map(|(i, &v)| Dual {
             v: Dual::cst(v),
-            d: std::array::from_fn(|j| if j == i { Dual::one() } else { Dual::zero() }),
+            d: std::array::from_fn(|j| if cu.start + j == i { Dual::one() } else { Dual::zero() }),
         })
         .collect();
-    let tt: D2<KQ, KU> = outer_cst(Dual::var(t, nq));
+    let tt: D2<KQ, KU> = outer_cst(seed_one(t, nq, &cq));
     let ctx = LocalCtx::new(sys, &el.bodies, &ql, &ul, &[], tt, ext);
     let mut out = vec![Dual::zero(); el.neq];
     el.kind.eval(&ctx, &mut out);
-    let mut r = ConstraintSecond { k, c: vec![], grad: vec![], hess: vec![] };
-    for e in &out {
-        r.c.push(e.v.v);
-        let mut g = vec![0.0; k];
-        g[..nq].copy_from_slice(&e.v.d[..nq]);
-        for a in 0..nq {
-            g[nq + a] = e.d[a].v;
+    // Column of z = (q, u, t) of inner variable `z` (q, or t at nq).
+    let col = |z: usize| if z < nq { z } else { 2 * nq };
+    for (e, o) in out.iter().enumerate() {
+        r.c[e] = o.v.v;
+        let g = &mut r.grad[e * k..(e + 1) * k];
+        for z in cq.clone() {
+            g[col(z)] = o.v.d[z - cq.start];
         }
-        g[2 * nq] = e.v.d[nq];
-        r.grad.extend(g);
-        let mut h = vec![0.0; k * k];
-        for a in 0..nq {
-            for c in 0..nq {
-                h[(nq + a) * k + c] = e.d[a].d[c];
-                h[c * k + nq + a] = e.d[a].d[c];
+        for a in cu.clone() {
+            g[nq + a] = o.d[a - cu.start].v;
+        }
+        let h = &mut r.hess[e * k * k..(e + 1) * k * k];
+        for a in cu.clone() {
+            for z in cq.clone() {
+                let x = o.d[a - cu.start].d[z - cq.start];
+                h[(nq + a) * k + col(z)] = x;
+                h[col(z) * k + nq + a] = x;
             }
-            h[(nq + a) * k + 2 * nq] = e.d[a].d[nq];
-            h[2 * nq * k + nq + a] = e.d[a].d[nq];
         }
-        r.hess.extend(h);
     }
-    r
 }
 
 /// Generalized forces of one element on its bodies (6 per local body).
@@ -205,9 +272,14 @@ pub fn force_jacobian(
     t: f64,
     inputs: &[f64],
 ) -> (Vec<f64>, Vec<f64>) {
-    by_width!(2 * nql(sys, &el.bodies) + 1, force_jac_k, [1, 13, 25, 37, 49, 61, 73](sys, el, q, u, t, inputs))
+    let nq = nql(sys, &el.bodies);
+    let mut r = (vec![0.0; nq], vec![0.0; nq * 2 * nq]);
+    by_width!(2 * nq, force_jac_k, [1, 12, 24, 36, 48, 60, 72](sys, el, q, u, t, inputs, &mut r));
+    r
 }
 
+/// The columns `chunk` of z = (local q, local u) of [`force_jacobian`].
+#[allow(clippy::too_many_arguments)]
 fn force_jac_k<const K: usize>(
     sys: &System,
     el: &ForceEl,
@@ -215,17 +287,21 @@ fn force_jac_k<const K: usize>(
     u: &[f64],
     t: f64,
     inputs: &[f64],
-) -> (Vec<f64>, Vec<f64>) {
+    (vals, jac): &mut (Vec<f64>, Vec<f64>),
+    chunk: Range<usize>,
+) {
     let nq = nql(sys, &el.bodies);
-    let ql: Vec<Dual<f64, K>> = gather(sys, &el.bodies, q).iter().enumerate().map(|(k, &v)| Dual::var(v, k)).collect();
-    let ul: Vec<Dual<f64, K>> =
-        gather(sys, &el.bodies, u).iter().enumerate().map(|(k, &v)| Dual::var(v, nq + k)).collect();
+    let ql: Vec<Dual<f64, K>> = seed(&gather(sys, &el.bodies, q), 0, &chunk);
+    let ul: Vec<Dual<f64, K>> = seed(&gather(sys, &el.bodies, u), nq, &chunk);
     let ctx = LocalCtx::new(sys, &el.bodies, &ql, &ul, &[], Dual::cst(t), inputs);
     let mut out = vec![Dual::zero(); nq];
     el.generalized(&ctx, &mut out);
-    let vals = out.iter().map(|e| e.v).collect();
-    let jac = out.iter().flat_map(|e| e.d[..2 * nq].to_vec()).collect();
-    (vals, jac)
+    for (i, e) in out.iter().enumerate() {
+        vals[i] = e.v;
+        for z in chunk.clone() {
+            jac[i * 2 * nq + z] = e.d[z - chunk.start];
+        }
+    }
 }
 
 /// ∂q̇_b/∂q_b (6×6, row-major) for one body: only the Euler-angle rows depend on θ, φ.
@@ -306,8 +382,9 @@ pub struct UserJacobian {
 
 /// Value and exact derivatives of a user row.
 pub fn user_jacobian(sys: &System, ue: &UserEq, q: &[f64], u: &[f64], t: f64, ext: &[f64]) -> UserJacobian {
-    let (value, dqu) =
-        by_width!(2 * nql(sys, &ue.bodies), user_qu_k, [1, 12, 24, 36, 48, 60, 72](sys, ue, q, u, t, ext));
+    let n = 2 * nql(sys, &ue.bodies);
+    let (mut value, mut dqu) = (0.0, vec![0.0; n]);
+    by_width!(n, user_qu_k, [1, 12, 24, 36, 48, 60, 72](sys, ue, q, u, t, ext, &mut value, &mut dqu));
     let (ql, ul) = (gather(sys, &ue.bodies, q), gather(sys, &ue.bodies, u));
     let dext = ue
         .ext_refs
@@ -322,11 +399,25 @@ pub fn user_jacobian(sys: &System, ue: &UserEq, q: &[f64], u: &[f64], t: f64, ex
     UserJacobian { value, dqu, dext }
 }
 
-fn user_qu_k<const K: usize>(sys: &System, ue: &UserEq, q: &[f64], u: &[f64], t: f64, ext: &[f64]) -> (f64, Vec<f64>) {
+/// The columns `chunk` of z = (local q, local u) of a user row's gradient.
+#[allow(clippy::too_many_arguments)]
+fn user_qu_k<const K: usize>(
+    sys: &System,
+    ue: &UserEq,
+    q: &[f64],
+    u: &[f64],
+    t: f64,
+    ext: &[f64],
+    value: &mut f64,
+    dqu: &mut [f64],
+    chunk: Range<usize>,
+) {
     let nq = nql(sys, &ue.bodies);
-    let ql: Vec<Dual<f64, K>> = gather(sys, &ue.bodies, q).iter().enumerate().map(|(k, &v)| Dual::var(v, k)).collect();
-    let ul: Vec<Dual<f64, K>> =
-        gather(sys, &ue.bodies, u).iter().enumerate().map(|(k, &v)| Dual::var(v, nq + k)).collect();
+    let ql: Vec<Dual<f64, K>> = seed(&gather(sys, &ue.bodies, q), 0, &chunk);
+    let ul: Vec<Dual<f64, K>> = seed(&gather(sys, &ue.bodies, u), nq, &chunk);
     let r = ue.residual(&LocalCtx::new(sys, &ue.bodies, &ql, &ul, &[], Dual::cst(t), ext));
-    (r.v, r.d[..2 * nq].to_vec())
+    *value = r.v;
+    for z in chunk.clone() {
+        dqu[z] = r.d[z - chunk.start];
+    }
 }

@@ -18,9 +18,11 @@ use super::coords::{gather, local_columns};
 use super::forces::ForceEl;
 use super::local::LocalCtx;
 use super::system::{ElementSlot, System};
+use crate::ad::chunked::{by_width, chunks, seed};
 use crate::ad::{Dual, Real};
 use crate::geom::V3;
 use crate::model::expr::{ElementRef, ExprEnv};
+use std::ops::Range;
 
 pub use super::load_components::{NLOAD, load_index};
 
@@ -120,13 +122,10 @@ pub fn load_gradient(
         ElementSlot::Force(k) => {
             let el = sys.forces.get(k)?;
             let (ql, ul) = (gather(sys, &el.bodies, q), gather(sys, &el.bodies, u));
-            let (value, dz) = match el.bodies.len() {
-                0 => force_grad_k::<1>(sys, el, &ql, &ul, t, inputs),
-                1 => force_grad_k::<12>(sys, el, &ql, &ul, t, inputs),
-                2 => force_grad_k::<24>(sys, el, &ql, &ul, t, inputs),
-                3 => force_grad_k::<36>(sys, el, &ql, &ul, t, inputs),
-                _ => force_grad_k::<48>(sys, el, &ql, &ul, t, inputs),
-            };
+            let n = 2 * ql.len();
+            let mut grad = ([0.0; NLOAD], vec![0.0; NLOAD * n]);
+            by_width!(n, force_grad_k, [1, 12, 24, 36, 48](sys, el, (&ql, &ul), t, inputs, &mut grad));
+            let (value, dz) = grad;
             let dv = force_input_gradient(sys, el, &ql, &ul, t, inputs);
             Some(LoadGradient {
                 bodies: el.bodies.clone(),
@@ -142,13 +141,14 @@ pub fn load_gradient(
             let el = sys.constraints.get(k)?;
             let ql = gather(sys, &el.bodies, q);
             let lam = &lam[el.row..el.row + el.neq];
-            let (value, dq, dlam) = match el.bodies.len() {
-                0 => return None,
-                1 => constraint_grad_k::<12>(sys, el, &ql, lam, t, inputs)?,
-                2 => constraint_grad_k::<18>(sys, el, &ql, lam, t, inputs)?,
-                3 => constraint_grad_k::<24>(sys, el, &ql, lam, t, inputs)?,
-                _ => constraint_grad_k::<30>(sys, el, &ql, lam, t, inputs)?,
-            };
+            if el.bodies.is_empty() {
+                return None;
+            }
+            let n = ql.len() + lam.len();
+            let mut grad: Option<ConstraintLoadGrad> =
+                Some(([0.0; NLOAD], vec![0.0; NLOAD * ql.len()], vec![0.0; NLOAD * lam.len()]));
+            by_width!(n, constraint_grad_k, [1, 12, 18, 24, 30](sys, el, (&ql, lam), t, inputs, &mut grad));
+            let (value, dq, dlam) = grad?;
             // The load does not depend on u (λ is given): zero u columns.
             let nql = ql.len();
             let mut dz = vec![0.0; NLOAD * 2 * nql];
@@ -186,20 +186,27 @@ fn force_load<T: Real>(
     [f[0], f[1], f[2], m[0], m[1], m[2]]
 }
 
-/// Value and ∂/∂(local q, local u) of a force element's load; K ≥ 12·nb.
+/// The columns `chunk` of z = (local q, local u) of the gradient of a force element's
+/// load (NLOAD rows of 2·nq), and its value.
 fn force_grad_k<const K: usize>(
     sys: &System,
     el: &ForceEl,
-    ql: &[f64],
-    ul: &[f64],
+    (ql, ul): (&[f64], &[f64]),
     t: f64,
     inputs: &[f64],
-) -> ([f64; NLOAD], Vec<f64>) {
-    let nq = ql.len();
-    let qd: Vec<Dual<f64, K>> = ql.iter().enumerate().map(|(k, &v)| Dual::var(v, k)).collect();
-    let ud: Vec<Dual<f64, K>> = ul.iter().enumerate().map(|(k, &v)| Dual::var(v, nq + k)).collect();
+    (value, dz): &mut ([f64; NLOAD], Vec<f64>),
+    chunk: Range<usize>,
+) {
+    let n = 2 * ql.len();
+    let qd: Vec<Dual<f64, K>> = seed(ql, 0, &chunk);
+    let ud: Vec<Dual<f64, K>> = seed(ul, ql.len(), &chunk);
     let l = force_load(sys, el, &qd, &ud, t, inputs, None);
-    (l.map(|c| c.v), l.iter().flat_map(|c| c.d[..2 * nq].to_vec()).collect())
+    *value = l.map(|c| c.v);
+    for (c, x) in l.iter().enumerate() {
+        for z in chunk.clone() {
+            dz[c * n + z] = x.d[z - chunk.start];
+        }
+    }
 }
 
 /// ∂load/∂v of a force element: one dual pass per input (NLOAD rows × ni, row-major).
@@ -217,23 +224,34 @@ fn force_input_gradient(sys: &System, el: &ForceEl, ql: &[f64], ul: &[f64], t: f
     dv
 }
 
-/// Value, ∂/∂(local q) (NLOAD × 6nb) and ∂/∂λ (NLOAD × neq) of a constraint element's
-/// load; K ≥ 6·nb + neq (at most 6 equations per element).
+/// A constraint element's load, its ∂/∂(local q) (NLOAD × nq) and ∂/∂λ (NLOAD × neq).
+type ConstraintLoadGrad = ([f64; NLOAD], Vec<f64>, Vec<f64>);
+
+/// The columns `chunk` of z = (local q, λ) of a [`ConstraintLoadGrad`] (set to `None`
+/// when the element has no load).
 fn constraint_grad_k<const K: usize>(
     sys: &System,
     el: &ConstraintEl,
-    ql: &[f64],
-    lam: &[f64],
+    (ql, lam): (&[f64], &[f64]),
     t: f64,
     inputs: &[f64],
-) -> Option<([f64; NLOAD], Vec<f64>, Vec<f64>)> {
-    let nq = ql.len();
-    let qd: Vec<Dual<f64, K>> = ql.iter().enumerate().map(|(k, &v)| Dual::var(v, k)).collect();
-    let ld: Vec<Dual<f64, K>> = lam.iter().enumerate().map(|(e, &v)| Dual::var(v, nq + e)).collect();
-    let l = constraint_load(sys, el, &qd, &ld, t, inputs)?;
-    let dq = l.iter().flat_map(|c| c.d[..nq].to_vec()).collect();
-    let dlam = l.iter().flat_map(|c| c.d[nq..nq + lam.len()].to_vec()).collect();
-    Some((l.map(|c| c.v), dq, dlam))
+    grad: &mut Option<ConstraintLoadGrad>,
+    chunk: Range<usize>,
+) {
+    let (nq, ne) = (ql.len(), lam.len());
+    let qd: Vec<Dual<f64, K>> = seed(ql, 0, &chunk);
+    let ld: Vec<Dual<f64, K>> = seed(lam, nq, &chunk);
+    let (Some(l), Some((value, dq, dlam))) = (constraint_load(sys, el, &qd, &ld, t, inputs), grad.as_mut()) else {
+        *grad = None;
+        return;
+    };
+    *value = l.map(|c| c.v);
+    for (c, x) in l.iter().enumerate() {
+        for z in chunk.clone() {
+            let d = x.d[z - chunk.start];
+            if z < nq { dq[c * nq + z] = d } else { dlam[c * ne + z - nq] = d }
+        }
+    }
 }
 
 /// Constraint element load over any scalar, from local q and the element's λ rows.
@@ -251,13 +269,10 @@ fn constraint_load<T: Real>(
         | ConstraintKind::Translation { i, j, .. } => (*i, *j),
         ConstraintKind::User { .. } | ConstraintKind::WheelContact { .. } => return None,
     };
-    let cq = match el.bodies.len() {
-        0 => return None,
-        1 => constraint_jacobian::<T, 6>(sys, el, ql, t, inputs),
-        2 => constraint_jacobian::<T, 12>(sys, el, ql, t, inputs),
-        3 => constraint_jacobian::<T, 18>(sys, el, ql, t, inputs),
-        _ => constraint_jacobian::<T, 24>(sys, el, ql, t, inputs),
-    };
+    if el.bodies.is_empty() {
+        return None;
+    }
+    let cq = constraint_jacobian(sys, el, ql, t, inputs);
     // Generalized constraint force on the element's bodies: −Σ_e P_eᵀ λ_e (Eq. 13a),
     // P_e = C_q,e H body by body.
     let nql = ql.len();
@@ -289,19 +304,39 @@ fn constraint_load<T: Real>(
     }
 }
 
-/// C_q of a constraint element (neq × 6nb, row-major) over any scalar: one dual level
-/// above `T`, seeded on the local q; K ≥ 6·nb.
-fn constraint_jacobian<T: Real, const K: usize>(
-    sys: &System,
-    el: &ConstraintEl,
-    ql: &[T],
-    t: f64,
-    inputs: &[f64],
-) -> Vec<T> {
+/// C_q of a constraint element (neq × nq, row-major) over any scalar: one dual level
+/// above `T`, seeded on the local q (at most 24 at a time).
+fn constraint_jacobian<T: Real>(sys: &System, el: &ConstraintEl, ql: &[T], t: f64, inputs: &[f64]) -> Vec<T> {
     let nq = ql.len();
-    let qd: Vec<Dual<T, K>> = ql.iter().enumerate().map(|(k, &v)| Dual::var(v, k)).collect();
+    let mut cq = vec![T::zero(); el.neq * nq];
+    let args = (sys, el, ql, t, inputs);
+    match nq {
+        0..=6 => cq_chunk::<T, 6>(args, &mut cq, 0..nq),
+        7..=12 => cq_chunk::<T, 12>(args, &mut cq, 0..nq),
+        13..=18 => cq_chunk::<T, 18>(args, &mut cq, 0..nq),
+        _ => chunks(nq, 24).for_each(|c| cq_chunk::<T, 24>(args, &mut cq, c)),
+    }
+    cq
+}
+
+/// The columns `chunk` of [`constraint_jacobian`].
+fn cq_chunk<T: Real, const K: usize>(
+    (sys, el, ql, t, inputs): (&System, &ConstraintEl, &[T], f64, &[f64]),
+    cq: &mut [T],
+    chunk: Range<usize>,
+) {
+    let nq = ql.len();
+    let qd: Vec<Dual<T, K>> = ql
+        .iter()
+        .enumerate()
+        .map(|(k, &v)| if chunk.contains(&k) { Dual::var(v, k - chunk.start) } else { Dual { v, d: [T::zero(); K] } })
+        .collect();
     let ctx = LocalCtx::new(sys, &el.bodies, &qd, &[], &[], Dual::cst(t), inputs);
     let mut out = vec![Dual::zero(); el.neq];
     el.kind.eval(&ctx, &mut out);
-    out.iter().flat_map(|e| e.d[..nq].to_vec()).collect()
+    for (e, o) in out.iter().enumerate() {
+        for k in chunk.clone() {
+            cq[e * nq + k] = o.d[k - chunk.start];
+        }
+    }
 }

@@ -65,13 +65,21 @@ pub struct LocalCtx<'a, T: Real> {
     modal: Vec<[Vec<T>; 3]>,
 }
 
+/// A node marker's offset and rotation in body axes with their rates: ([p, ṗ, p̈],
+/// [θ, θ̇, θ̈]).
+type NodeMotion<T> = ([V3<T>; 3], [V3<T>; 3]);
+
 /// A node marker's deflection in body axes: Σ_k v_k x_k over the modes.
 fn modal_sum<T: Real>(v: &[[f64; 3]], x: &[T]) -> V3<T> {
-    let mut s = V3::zero();
-    for (vk, &xk) in v.iter().zip(x) {
-        s = s + V3::cst(*vk).mul_s(xk);
+    let mut s = [T::zero(); 3];
+    for (vk, xk) in v.iter().zip(x) {
+        for (sc, &c) in s.iter_mut().zip(vk) {
+            if c != 0.0 {
+                sc.add_scaled(xk, c);
+            }
+        }
     }
-    s
+    V3(s)
 }
 
 impl<'a, T: Real> LocalCtx<'a, T> {
@@ -118,19 +126,19 @@ impl<'a, T: Real> LocalCtx<'a, T> {
         self.modal[local][0][k]
     }
 
-    /// A node marker's body-frame offset p = s + Φt η, rotation θ = Φr η and their first
-    /// and second rates (None: the marker is rigidly attached).
-    fn node_motion(&self, m: MarkerId) -> Option<[V3<T>; 6]> {
+    /// A node marker's body-frame offset p = s + Φt η and rotation θ = Φr η with their
+    /// rates up to order `level` (0, 1 or 2; higher rates are left zero): ([p, ṗ, p̈],
+    /// [θ, θ̇, θ̈]). None: the marker is rigidly attached.
+    fn node_motion(&self, m: MarkerId, level: usize) -> Option<NodeMotion<T>> {
         let shape = self.sys.markers[m].node.as_ref()?;
-        let [eta, etad, etadd] = &self.modal[self.local(self.sys.markers[m].body?)];
-        Some([
-            self.offset(m) + modal_sum(&shape.phi, eta),
-            modal_sum(&shape.phi, etad),
-            modal_sum(&shape.phi, etadd),
-            modal_sum(&shape.rho, eta),
-            modal_sum(&shape.rho, etad),
-            modal_sum(&shape.rho, etadd),
-        ])
+        let modal = &self.modal[self.local(self.sys.markers[m].body?)];
+        let (mut p, mut th) = ([V3::zero(); 3], [V3::zero(); 3]);
+        for (l, x) in modal.iter().enumerate().take(level + 1) {
+            p[l] = modal_sum(&shape.phi, x);
+            th[l] = modal_sum(&shape.rho, x);
+        }
+        p[0] = self.offset(m) + p[0];
+        Some((p, th))
     }
 
     /// Evaluate expression `e` whose angle measures use global slots from `angle_base`.
@@ -184,7 +192,7 @@ impl<T: Real> ExprEnv<T> for LocalCtx<'_, T> {
     }
     fn pose(&self, m: MarkerId) -> Pose<T> {
         let g = &self.sys.markers[m];
-        if let (Some(b), Some([p, _, _, th, _, _])) = (self.marker_body(m), self.node_motion(m)) {
+        if let (Some(b), Some(([p, _, _], [th, _, _]))) = (self.marker_body(m), self.node_motion(m, 0)) {
             // The node turns by the small rotation θ: axes (I + θ×) · marker axes.
             let o = T::one();
             let turn = M3([[o, -th.0[2], th.0[1]], [th.0[2], o, -th.0[0]], [-th.0[1], th.0[0], o]]);
@@ -196,7 +204,7 @@ impl<T: Real> ExprEnv<T> for LocalCtx<'_, T> {
         }
     }
     fn twist(&self, m: MarkerId) -> Twist<T> {
-        if let (Some(b), Some([p, pd, _, _, thd, _])) = (self.marker_body(m), self.node_motion(m)) {
+        if let (Some(b), Some(([p, pd, _], [_, thd, _]))) = (self.marker_body(m), self.node_motion(m, 1)) {
             return Twist { v: b.v + b.a.mv(&(b.w.cross(&p) + pd)), w: b.a.mv(&(b.w + thd)) };
         }
         match self.marker_body(m) {
@@ -208,7 +216,7 @@ impl<T: Real> ExprEnv<T> for LocalCtx<'_, T> {
         }
     }
     fn accel(&self, m: MarkerId) -> Twist<T> {
-        if let (Some(b), Some([p, pd, pdd, _, thd, thdd])) = (self.marker_body(m), self.node_motion(m)) {
+        if let (Some(b), Some(([p, pd, pdd], [_, thd, thdd]))) = (self.marker_body(m), self.node_motion(m, 2)) {
             // Given accelerations only: forces and user rows do not read a flexible
             // body's accelerations (refused when the system is built).
             let two = T::cst(2.0);

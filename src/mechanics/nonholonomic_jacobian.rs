@@ -4,18 +4,19 @@
 
 use super::body::{NQ, qdot};
 use super::coords::{gather, global_column};
-use super::kernels::nonholonomic_second;
+use super::kernels::nonholonomic_first;
 use super::system::System;
 
 /// γ of the non-holonomic acceleration constraint B u̇ + γ = 0: ġ at u̇ = 0, i.e.
-/// g_q q̇ + g_t.
+/// g_q q̇ + g_t (q̇ of modal coordinates: their rates).
 pub fn nonholonomic_gamma(sys: &System, q: &[f64], u: &[f64], t: f64, ext: &[f64]) -> Vec<f64> {
     let mut gamma = vec![0.0; sys.mn];
     for el in &sys.nonholonomic {
-        let s = nonholonomic_second(sys, el, q, u, t, ext);
+        let s = nonholonomic_first(sys, el, q, u, t, ext);
         let nql = crate::mechanics::coords::nql(sys, &el.bodies);
         let (ql, ul) = (gather(sys, &el.bodies, q), gather(sys, &el.bodies, u));
-        let mut qd = vec![0.0; nql];
+        // q̇ = H u for the six coordinates of each body, η̇ for the modal ones.
+        let mut qd = ul.clone();
         for kb in 0..el.bodies.len() {
             let r = NQ * kb..NQ * kb + NQ;
             qd[r.clone()].copy_from_slice(&qdot(&ql[r.clone()], &ul[r]));
@@ -33,7 +34,7 @@ pub fn nonholonomic_b(sys: &System, q: &[f64], u: &[f64], t: f64, ext: &[f64]) -
     let mut b = Vec::new();
     let mut g = vec![0.0; sys.mn];
     for el in &sys.nonholonomic {
-        let s = nonholonomic_second(sys, el, q, u, t, ext);
+        let s = nonholonomic_first(sys, el, q, u, t, ext);
         let nql = crate::mechanics::coords::nql(sys, &el.bodies);
         for e in 0..el.neq {
             g[el.row + e] = s.c[e];

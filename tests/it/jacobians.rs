@@ -2,13 +2,17 @@
 //! engine itself never differentiates numerically). The model deliberately mixes every
 //! joint type, motions, a user constraint and every force element on three bodies in
 //! general orientations; it need not be assemblable, since derivatives are checked at
-//! arbitrary states.
+//! arbitrary states. A second model puts a flexible body with 50 modes among them, its
+//! node markers on joints, forces and non-holonomic constraints: its elements have up to
+//! 68 local coordinates, so every derivative kernel seeds its dual numbers a chunk at a
+//! time, and those chunked derivatives are checked the same way.
 
 use mbfmu::dae::equations::{Layout, jacobian, rhs};
 use mbfmu::dae::sparse::Triplets;
 use mbfmu::mechanics::System;
 use mbfmu::mechanics::body::{NQ, qdot};
 use mbfmu::mechanics::constraint_jacobian::{acceleration_rhs, p_row};
+use mbfmu::mechanics::coords::{gather, nql};
 use mbfmu::mechanics::kernels::constraint_first;
 use mbfmu::model::parse::load_str;
 
@@ -72,17 +76,102 @@ fn rng(seed: &mut u64) -> f64 {
     ((*seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
 }
 
+/// The rigid kitchen sink at a pseudo-random state.
 fn setup() -> (System, Layout, Vec<f64>) {
     let model = load_str(KITCHEN_SINK, "sink.xml").unwrap_or_else(|e| panic!("{e}"));
     let sys = System::from_model(&model).unwrap();
     let lay = Layout::of(&sys);
     assert_eq!((lay.nx, lay.nv, lay.na), (2, 4, 18));
     assert_eq!(sys.load_refs.len(), 5);
+    let y = random_state(&sys, lay, 0.0);
+    (sys, lay, y)
+}
+
+/// Modes of the flexible sink's body: more than any dual number the kernels use is wide.
+const FLEX_MODES: usize = 50;
+
+/// The flexible sink: body `b` is a free-free beam (12 elements, 1 m along x) with
+/// [`FLEX_MODES`] modes, its markers on nodes, at a pseudo-random state. Modal
+/// coordinates ± 1e-3 m·√kg (deflections of a few mm, node rotations up to ~0.1 rad in
+/// the highest modes), rates ± 1e-2. Each test writes its data file in a directory of
+/// its own (`test`): tests run in parallel.
+fn setup_flexible(test: &str) -> (System, Layout, Vec<f64>) {
+    use mbfmu::modal::{BeamSpec, Material, Reduction, Section, beam, write};
+    let spec = BeamSpec {
+        length: 1.0,
+        elements: 12,
+        section: Section { area: 1e-3, iy: 2e-9, iz: 1e-9, j: 3e-9 },
+        material: Material { young: 7e9, shear: 2.7e9, density: 2700.0 },
+        modes: FLEX_MODES,
+        damping: Some(0.02),
+        clamp: None,
+        reduction: Reduction::FreeInterface,
+    };
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("jacobians-flexible").join(test);
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("beam.json"), write(&beam(&spec).unwrap())).unwrap();
+    let path = dir.join("sink.xml").display().to_string();
+    let model = load_str(FLEXIBLE_SINK, &path).unwrap_or_else(|e| panic!("{e}"));
+    let sys = System::from_model(&model).unwrap();
+    let lay = Layout::of(&sys);
+    assert_eq!(lay.n, 3 * NQ + FLEX_MODES);
+    assert!(sys.constraints.iter().any(|el| nql(&sys, &el.bodies) == 2 * NQ + FLEX_MODES));
+    let y = random_state(&sys, lay, 1e-3);
+    (sys, lay, y)
+}
+
+/// The flexible sink: the kitchen sink's elements with body `b` flexible (accelerations
+/// of a flexible body may not be read by forces, so `added_mass` reads body a).
+const FLEXIBLE_SINK: &str = r#"<multibody name="flexsink" version="1">
+  <gravity value="0.3 -0.2 -9.81"/>
+  <ground><marker name="O" position="0.1 0.2 0.3" euler313="0.2 0.7 -0.4"/></ground>
+  <body name="a" mass="1.3" inertia="0.2 0.3 0.4 0.01 -0.02 0.03" position="0.4 -0.1 0.2" euler313="0.3 1.1 0.5">
+    <marker name="m1" position="0.1 0.2 -0.1" euler313="-0.3 0.4 0.9"/>
+    <marker name="m2" position="-0.2 0.1 0.05" z_axis="0.2 1 0.3"/>
+  </body>
+  <flexible_body name="b" modal="beam.json" position="-0.3 0.5 0.1" euler313="1.2 2.0 -0.7"
+        velocity="0.1 0.2 -0.3" angular_velocity="0.5 -0.4 1.1">
+    <marker name="m1" node="3" euler313="0.5 0.3 0.2"/>
+    <marker name="m2" node="12" euler313="-1.0 1.3 0.1"/>
+    <marker name="mid" node="6"/>
+  </flexible_body>
+  <body name="c" mass="2.1" inertia="0.5 0.4 0.3" position="0.2 0.3 -0.6" euler313="-0.6 0.9 2.4">
+    <marker name="m1" position="-0.1 0.1 0.1" euler313="0.1 0.2 0.3"/>
+  </body>
+  <joint name="jfix" type="fixed" i="a.m1" j="b.m1"/>
+  <joint name="jrev" type="revolute" i="b.m2" j="c.m1"/>
+  <joint name="jsph" type="spherical" i="b.mid" j="c.m1"/>
+  <joint name="jpla" type="planar" i="c.cm" j="b.m2"/>
+  <joint name="juni" type="universal" i="a.cm" j="ground.O"/>
+  <motion name="mrot" joint="jrev" dof="rotation" function="0.3*sin(2*time) + 0.1*time^2"/>
+  <constraint name="uc" function="dx(a.m1, b.m2, c.m1)*cos(time) + az(b.m2, a.m2) + 0.2*modal(b, 40) - 0.1"/>
+  <spring_damper name="st" type="translational" i="a.m1" j="b.mid" stiffness="30" damping="0.7" length="0.3" preload="2"/>
+  <spring_damper name="sr" type="rotational" i="b.m2" j="a.m2" stiffness="5" damping="0.2" angle="0.1" preload="0.3"/>
+  <sforce name="ft" type="translational" i="b.m1" j="ground.O" function="-3*dm(b.m1, ground.O) - 0.5*vr(b.m1, ground.O) + sin(time)"/>
+  <gforce name="g1" i="a.m2" j="b.m1" frame="c.m1" force="vx(a.m2, b.m1)*2, -dy(a.m2), 1+time" torque="wz(b.mid)*0.5, 0.2, -dz(b.cm, a.cm, c.m1)"/>
+  <bushing name="bu" i="a.m2" j="b.mid" stiffness="10 20 30 4 5 6" damping="0.1 0.2 0.3 0.04 0.05 0.06"/>
+  <rolling_wheel name="wheel" marker="b.m2" radius="0.2" plane="c.m1"/>
+  <knife_edge name="knife" marker="b.m1"/>
+  <velocity_constraint name="vc" function="vx(c.cm)*dy(b.mid) + 0.3*wz(c.cm, b.m1, a.m1) - 0.2*sin(time) + modal_rate(b, 45)"/>
+  <input name="v"/>
+  <variable name="loop1" function="0.3*loop2 + dx(a.m1, b.cm) + v*xi + modal(b, 50)"/>
+  <variable name="loop2" function="-0.2*loop1^2 + sin(xi) + wz(b.mid)"/>
+  <differential name="xi" start="0.2" function="loop1 - 0.5*xi + vx(b.m2)"/>
+  <variable name="fric" function="0.2*sqrt(fz(jrev)^2 + 0.01) + 0.1*fx(st) - 0.05*ty(jsph) + 0.1*tz(bu)"/>
+  <sforce name="fu" type="translational" i="a.cm" j="b.m2" function="2*loop1 - xi + fric"/>
+  <sforce name="added_mass" type="translational" i="a.cm" j="ground.O" function="-0.4*accx(a.cm, ground.O, a.m1)"/>
+</multibody>"#;
+
+/// A state near the initial one: body coordinates ± 0.1, velocities ± 1, modal
+/// coordinates ± `eta` and their rates ± 10·`eta`, and λ, z at random.
+fn random_state(sys: &System, lay: Layout, eta: f64) -> Vec<f64> {
     let mut seed = 7;
     let mut y = vec![0.0; lay.dim()];
+    let modal = sys.modal_columns();
     for i in 0..lay.n {
-        y[i] = sys.q_init[i] + 0.1 * rng(&mut seed);
-        y[lay.u() + i] = sys.u_init[i] + rng(&mut seed);
+        let (dq, du) = if modal.contains(&i) { (eta, 10.0 * eta) } else { (0.1, 1.0) };
+        y[i] = sys.q_init[i] + dq * rng(&mut seed);
+        y[lay.u() + i] = sys.u_init[i] + du * rng(&mut seed);
     }
     for i in 0..lay.nz() {
         y[lay.z() + i] = rng(&mut seed);
@@ -90,16 +179,36 @@ fn setup() -> (System, Layout, Vec<f64>) {
     for i in 0..lay.m + lay.mn {
         y[lay.lam() + i] = 3.0 * rng(&mut seed); // λ then ν
     }
-    (sys, lay, y)
+    y
+}
+
+/// q̇ = H(q) u for every body, η̇ for the modal coordinates.
+fn qdot_all(sys: &System, q: &[f64], u: &[f64]) -> Vec<f64> {
+    let mut qd: Vec<f64> = (0..sys.nb()).flat_map(|b| qdot(&q[NQ * b..NQ * b + NQ], &u[NQ * b..NQ * b + NQ])).collect();
+    qd.extend_from_slice(&u[NQ * sys.nb()..]);
+    qd
 }
 
 #[test]
 fn jacobian_of_the_equations_of_motion_matches_central_differences() {
+    jacobian_matches_central_differences(setup());
+}
+
+/// The same with a 50-mode flexible body (chunked derivative kernels).
+#[test]
+fn jacobian_of_a_model_with_a_fifty_mode_body_matches_central_differences() {
+    jacobian_matches_central_differences(setup_flexible("jacobian"));
+}
+
+fn jacobian_matches_central_differences((sys, lay, y): (System, Layout, Vec<f64>)) {
     // J = ∂f/∂y is exact except the term ∂(C_qᵀμ)/∂q, which vanishes on the solution (μ = 0),
-    // so μ = 0 here. Central differences with h = 1e-6 have truncation error ~h²·|f'''| ≈ 1e-12
-    // and round-off ~ε|f|/h ≈ 1e-9 relative: agreement to 1e-6 (relative to max(1, |J|))
+    // so μ = 0 here. Fourth-order central differences, (8(f(h) − f(−h)) − (f(2h) − f(−2h)))
+    // / 12h with h = 1e-6: truncation ~h⁴·|f⁽⁵⁾|/30, round-off ~1.5ε|f|/h (allowed for
+    // explicitly: rows of large |f| with small derivatives lose digits to it). A
+    // flexible body's highest modes turn its nodes by ρ ~ 300 rad per unit η, so its
+    // derivatives grow as ρⁿ: second-order differences would err by h²ρ³/6 ≈ 5e-6 there,
+    // fourth-order ones by h⁴ρ⁵/30 ≈ 1e-13. Agreement to 1e-6 (relative to max(1, |J|))
     // leaves margin while catching any wrong term (errors of O(1)).
-    let (sys, lay, y) = setup();
     let t = 0.37;
     let n = lay.dim();
     let mut trip = Triplets::new();
@@ -111,15 +220,20 @@ fn jacobian_of_the_equations_of_motion_matches_central_differences() {
     let mut worst = (0.0f64, 0, 0);
     for c in 0..n {
         let h = 1e-6 * y[c].abs().max(1.0);
-        let (mut yp, mut ym) = (y.clone(), y.clone());
-        yp[c] += h;
-        ym[c] -= h;
-        let (mut fp, mut fm) = (vec![0.0; n], vec![0.0; n]);
-        rhs(&sys, lay, t, &yp, &INPUTS, &mut fp);
-        rhs(&sys, lay, t, &ym, &INPUTS, &mut fm);
+        let f_at = |s: f64| {
+            let mut ys = y.clone();
+            ys[c] += s;
+            let mut f = vec![0.0; n];
+            rhs(&sys, lay, t, &ys, &INPUTS, &mut f);
+            f
+        };
+        let (f1, fm1, f2, fm2) = (f_at(h), f_at(-h), f_at(2.0 * h), f_at(-2.0 * h));
         for r in 0..n {
-            let fd = (fp[r] - fm[r]) / (2.0 * h);
-            let e = (fd - jd[r * n + c]).abs() / jd[r * n + c].abs().max(1.0);
+            let fd = (8.0 * (f1[r] - fm1[r]) - (f2[r] - fm2[r])) / (12.0 * h);
+            // Round-off of the difference quotient, (16 + 2)·ε|f|/12h, ten times over.
+            let size = [f1[r], fm1[r], f2[r], fm2[r]].iter().fold(0.0f64, |a, x| a.max(x.abs()));
+            let roundoff = 15.0 * f64::EPSILON * size / h;
+            let e = ((fd - jd[r * n + c]).abs() - roundoff).max(0.0) / jd[r * n + c].abs().max(1.0);
             if e > worst.0 {
                 worst = (e, r, c);
             }
@@ -130,10 +244,19 @@ fn jacobian_of_the_equations_of_motion_matches_central_differences() {
 
 #[test]
 fn acceleration_right_hand_side_is_the_second_time_derivative_of_the_constraints() {
+    gamma_is_the_second_time_derivative_of_the_constraints(setup());
+}
+
+/// The same with a 50-mode flexible body (chunked second derivatives).
+#[test]
+fn acceleration_right_hand_side_with_a_fifty_mode_body_is_the_second_time_derivative() {
+    gamma_is_the_second_time_derivative_of_the_constraints(setup_flexible("gamma"));
+}
+
+fn gamma_is_the_second_time_derivative_of_the_constraints((sys, lay, y): (System, Layout, Vec<f64>)) {
     // C̈ = P u̇ + γ (Eq. 1c). Along the motion q' = H(q)u, u' = a (any a), t' = 1, the
     // central difference of Ċ(q, u, t) = P u + C_t over ±h must equal P a + γ. Tolerance as
     // above (second-order differences of smooth functions, h = 1e-5).
-    let (sys, lay, y) = setup();
     let t = 0.21;
     let (q, u) = (&y[..lay.n], &y[lay.u()..lay.u() + lay.n]);
     let mut seed = 11;
@@ -142,16 +265,16 @@ fn acceleration_right_hand_side_is_the_second_time_derivative_of_the_constraints
         let mut out = vec![0.0; sys.m];
         for el in &sys.constraints {
             let f = constraint_first(&sys, el, q, t, &[]);
-            let nql = NQ * el.bodies.len();
+            let nql = nql(&sys, &el.bodies);
             for e in 0..el.neq {
                 let p = p_row(&el.bodies, q, &f.cq[e * nql..(e + 1) * nql]);
-                let ul: Vec<f64> = el.bodies.iter().flat_map(|&b| u[NQ * b..NQ * b + NQ].to_vec()).collect();
+                let ul = gather(&sys, &el.bodies, u);
                 out[el.row + e] = p.iter().zip(&ul).map(|(x, y)| x * y).sum::<f64>() + f.ct[e];
             }
         }
         out
     };
-    let qd: Vec<f64> = (0..sys.nb()).flat_map(|b| qdot(&q[NQ * b..NQ * b + NQ], &u[NQ * b..NQ * b + NQ])).collect();
+    let qd = qdot_all(&sys, q, u);
     let h = 1e-5;
     let shift = |s: f64| -> (Vec<f64>, Vec<f64>) {
         // Second-order accurate point on the trajectory: q(t+s) ≈ q + s q' + s²/2 q''; the
@@ -165,11 +288,11 @@ fn acceleration_right_hand_side_is_the_second_time_derivative_of_the_constraints
     let gamma = acceleration_rhs(&sys, q, u, t, &[]);
     for el in &sys.constraints {
         let f = constraint_first(&sys, el, q, t, &[]);
-        let nql = NQ * el.bodies.len();
+        let nql = nql(&sys, &el.bodies);
         for e in 0..el.neq {
             let r = el.row + e;
             let p = p_row(&el.bodies, q, &f.cq[e * nql..(e + 1) * nql]);
-            let al: Vec<f64> = el.bodies.iter().flat_map(|&b| a[NQ * b..NQ * b + NQ].to_vec()).collect();
+            let al = gather(&sys, &el.bodies, &a);
             let want = p.iter().zip(&al).map(|(x, y)| x * y).sum::<f64>() + gamma[r];
             let fd = (cp[r] - cm[r]) / (2.0 * h);
             assert!((fd - want).abs() < 1e-6 * want.abs().max(1.0), "{} eq {e}: fd {fd} vs {want}", el.name);
@@ -179,17 +302,26 @@ fn acceleration_right_hand_side_is_the_second_time_derivative_of_the_constraints
 
 #[test]
 fn nonholonomic_acceleration_right_hand_side_is_the_time_derivative_of_g() {
+    nonholonomic_gamma_is_the_time_derivative_of_g(setup(), 6);
+}
+
+/// The same with a 50-mode flexible body (chunked mixed second derivatives).
+#[test]
+fn nonholonomic_right_hand_side_with_a_fifty_mode_body_is_the_time_derivative_of_g() {
+    nonholonomic_gamma_is_the_time_derivative_of_g(setup_flexible("nonholonomic"), 4);
+}
+
+fn nonholonomic_gamma_is_the_time_derivative_of_g((sys, lay, y): (System, Layout, Vec<f64>), mn: usize) {
     // ġ = B u̇ + γ_nh along q' = H(q)u, u' = a, t' = 1: central differences of g over ±h
     // against B a + γ_nh (h = 1e-5, tolerance as above).
     use mbfmu::mechanics::nonholonomic_jacobian::{nonholonomic_b, nonholonomic_gamma};
-    let (sys, lay, y) = setup();
-    assert_eq!(sys.mn, 6);
+    assert_eq!(sys.mn, mn);
     let t = 0.43;
     let (q, u) = (&y[..lay.n], &y[lay.u()..lay.u() + lay.n]);
     let ext = lay.ext(&sys, &INPUTS, &y, t);
     let mut seed = 5;
     let a: Vec<f64> = (0..lay.n).map(|_| rng(&mut seed)).collect();
-    let qd: Vec<f64> = (0..sys.nb()).flat_map(|b| qdot(&q[NQ * b..NQ * b + NQ], &u[NQ * b..NQ * b + NQ])).collect();
+    let qd = qdot_all(&sys, q, u);
     let h = 1e-5;
     let at = |s: f64| -> Vec<f64> {
         let qs: Vec<f64> = (0..lay.n).map(|i| q[i] + s * qd[i]).collect();

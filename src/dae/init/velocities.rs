@@ -3,7 +3,7 @@
 //! saddle-point system [I Pᵀ Bᵀ Aᵀ; P 0; B 0; A 0] (A: the rows of the velocity ICs).
 
 use super::kkt::push_p_blocks;
-use crate::ad::{Dual, Real};
+use crate::ad::{Dual, Real, chunked};
 use crate::dae::sparse::{SparseLu, Triplets};
 use crate::mechanics::System;
 use crate::mechanics::coords::{gather, global_column};
@@ -36,21 +36,20 @@ pub fn assemble_velocities(sys: &System, q: &[f64], u: &mut [f64], t: f64, input
     }
     for (k, ic) in sys.ic_velocities.iter().enumerate() {
         // Linear in u: residual(u) = a·u − value; a from dual numbers seeded on u.
-        let ql: Vec<Dual<f64, { crate::mechanics::kernels::MAX_LOCAL }>> =
-            gather(sys, &ic.bodies, q).iter().map(|&v| Dual::cst(v)).collect();
-        let ul: Vec<Dual<f64, { crate::mechanics::kernels::MAX_LOCAL }>> =
-            gather(sys, &ic.bodies, u).iter().enumerate().map(|(i, &v)| Dual::var(v, i)).collect();
-        let ctx = LocalCtx::new(sys, &ic.bodies, &ql, &ul, &[], Dual::cst(t), inputs);
-        let res = ic.eval(&ctx);
+        let ql = gather(sys, &ic.bodies, q);
+        let (res, a) = chunked::jacobian(&gather(sys, &ic.bodies, u), |ul| {
+            let ql: Vec<_> = ql.iter().map(|&v| Dual::cst(v)).collect();
+            vec![ic.eval(&LocalCtx::new(sys, &ic.bodies, &ql, ul, &[], Dual::cst(t), inputs))]
+        });
         let r = ic0 + k;
         let mut au = 0.0;
-        for (a, &d) in res.d.iter().enumerate().take(ul.len()) {
-            let g = global_column(sys, &ic.bodies, a);
+        for (c, &d) in a.iter().enumerate() {
+            let g = global_column(sys, &ic.bodies, c);
             kkt.push(r, g, d);
             kkt.push(g, r, d);
             au += d * u[g];
         }
-        rhs[r] = au - res.val();
+        rhs[r] = au - res[0];
     }
     let mut lu = SparseLu::new();
     lu.factor(dim, &kkt).map_err(|e| format!("cannot make velocities consistent: {e}"))?;
