@@ -47,6 +47,7 @@ fn arm(elements: usize, modes: usize) -> mbfmu::modal::ModalData {
         damping: Some(0.02),
         clamp: None,
         reduction: Reduction::CraigBampton { interface: vec![0, elements as u32], fixed_modes: modes - 6 },
+        shear_coefficient: None,
     })
     .unwrap()
 }
@@ -90,6 +91,7 @@ fn main() {
                         damping: Some(0.01),
                         clamp: (name == "cantilever").then_some(0),
                         reduction: Reduction::FreeInterface,
+                        shear_coefficient: None,
                     })
                     .unwrap()
                 };

@@ -22,7 +22,8 @@ pub struct ModalArgs {
 #[derive(Clone, Debug, Subcommand)]
 pub enum ModalCommand {
     /// A straight beam along body x (node 0 at x = 0, node N at x = L): N Euler–Bernoulli
-    /// elements, lumped mass, n modes mass-normalized with respect to the node masses.
+    /// (or, with --timoshenko, Timoshenko) elements, lumped mass, n modes mass-normalized
+    /// with respect to the node masses.
     Beam(BeamArgs),
 }
 
@@ -63,6 +64,11 @@ pub struct BeamArgs {
     /// Density ρ (kg/m³).
     #[arg(long, allow_negative_numbers = true)]
     pub density: f64,
+    /// Timoshenko elements (shear deformation and the section's rotary inertia) with this
+    /// shear coefficient κ (5/6 for a solid rectangle, 0.9 for a solid circle); default:
+    /// Euler–Bernoulli elements.
+    #[arg(long, value_name = "KAPPA", allow_negative_numbers = true)]
+    pub timoshenko: Option<f64>,
     /// Damping ratio ζ of every mode (default: undamped).
     #[arg(long, allow_negative_numbers = true)]
     pub damping: Option<f64>,
@@ -113,6 +119,7 @@ pub fn beam_spec(a: &BeamArgs) -> Result<BeamSpec, CliError> {
         damping: a.damping,
         clamp: a.clamp,
         reduction,
+        shear_coefficient: a.timoshenko,
     })
 }
 

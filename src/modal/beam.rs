@@ -1,6 +1,6 @@
 //! `mbfmu modal beam`: the modal data of a straight beam along body x (node 0 at x = 0,
 //! node N at x = L), from its finite-element model ([`super::beam_fe`]: Euler–Bernoulli
-//! elements, lumped mass matrix M) reduced to n modes in one of two ways:
+//! or Timoshenko elements, lumped mass matrix M) reduced to n modes in one of two ways:
 //!
 //! - free-interface normal modes: K φ = ω² M φ ([`super::eigen`]); the six rigid-body
 //!   modes (the six smallest eigenvalues, checked to be ≈ 0) are dropped, the next n kept;
@@ -62,12 +62,16 @@ pub struct BeamSpec {
     pub clamp: Option<u32>,
     /// Free-interface or Craig–Bampton.
     pub reduction: Reduction,
+    /// Timoshenko elements (shear deformation, section rotary inertia) with this shear
+    /// coefficient κ (5/6 for a solid rectangle, 0.9 for a solid circle); None:
+    /// Euler–Bernoulli.
+    pub shear_coefficient: Option<f64>,
 }
 
 /// The modal data of the beam `spec` describes; the error says which value is wrong.
 pub fn beam(spec: &BeamSpec) -> Result<ModalData, String> {
     check(spec)?;
-    let fe = assemble(spec.length, spec.elements, &spec.section, &spec.material);
+    let fe = assemble(spec.length, spec.elements, &spec.section, &spec.material, spec.shear_coefficient);
     let n_all = fe.mass.len();
     let clamped: Vec<usize> = spec.clamp.map_or(Vec::new(), |c| (6 * c as usize..6 * c as usize + 6).collect());
     let free: Vec<usize> = (0..n_all).filter(|d| !clamped.contains(d)).collect();
@@ -158,6 +162,9 @@ fn check(spec: &BeamSpec) -> Result<(), String> {
     if spec.modes == 0 {
         return Err("--modes 0: must be at least 1".into());
     }
+    if let Some(k) = spec.shear_coefficient.filter(|k| !(k.is_finite() && *k > 0.0)) {
+        return Err(format!("--timoshenko {k}: the shear coefficient must be a finite number > 0"));
+    }
     if let Some(z) = spec.damping.filter(|z| !(z.is_finite() && *z >= 0.0)) {
         return Err(format!("--damping {z}: must be a finite number ≥ 0"));
     }
@@ -199,8 +206,10 @@ fn describe(spec: &BeamSpec) -> String {
         }
     };
     let clamp = spec.clamp.map_or(String::new(), |c| format!(", node {c} clamped"));
+    let theory =
+        spec.shear_coefficient.map_or("Euler-Bernoulli".to_string(), |k| format!("Timoshenko (kappa = {k:?})"));
     format!(
-        "mbfmu modal beam: L = {:?} m, {} Euler-Bernoulli elements, lumped mass; A = {:?}, Iy = {:?}, Iz = {:?}, J = {:?}, E = {:?}, G = {:?}, rho = {:?}; {how}{clamp}",
+        "mbfmu modal beam: L = {:?} m, {} {theory} elements, lumped mass; A = {:?}, Iy = {:?}, Iz = {:?}, J = {:?}, E = {:?}, G = {:?}, rho = {:?}; {how}{clamp}",
         spec.length, spec.elements, s.area, s.iy, s.iz, s.j, m.young, m.shear, m.density
     )
 }

@@ -1,19 +1,24 @@
-//! The finite-element model of a straight beam along body x: equal 3-D Euler–Bernoulli
-//! elements, six degrees of freedom per node [u, v, w, θx, θy, θz], the stiffness from
-//! linear (axial, torsion) and Hermite cubic (bending) shape functions, and a LUMPED
-//! (diagonal) mass matrix.
+//! The finite-element model of a straight beam along body x: equal 3-D elements, six
+//! degrees of freedom per node [u, v, w, θx, θy, θz], the stiffness from linear (axial,
+//! torsion) and cubic (bending) shape functions, and a LUMPED (diagonal) mass matrix.
+//! Euler–Bernoulli elements, or Timoshenko elements (shear deformation and the section's
+//! rotary inertia) when a shear coefficient κ is given.
 //!
 //! Element of length ℓ: axial EA/ℓ·[1 −1; −1 1]; torsion GJ/ℓ·[1 −1; −1 1]; bending in the
-//! x-y plane (v, θz) EIz/ℓ³·[12 6ℓ −12 6ℓ; 6ℓ 4ℓ² −6ℓ 2ℓ²; −12 −6ℓ 12 −6ℓ; 6ℓ 2ℓ² −6ℓ 4ℓ²];
-//! in the x-z plane (w, θy) EIy/ℓ³ times the same with the 6ℓ terms negated (θy = −w').
+//! x-y plane (v, θz) EIz/((1 + Φ)ℓ³)·[12 6ℓ −12 6ℓ; 6ℓ (4+Φ)ℓ² −6ℓ (2−Φ)ℓ²; −12 −6ℓ 12 −6ℓ;
+//! 6ℓ (2−Φ)ℓ² −6ℓ (4+Φ)ℓ²] with Φ = 12EIz/(κGAℓ²) (Φ = 0: Euler–Bernoulli); in the x-z
+//! plane (w, θy) the same with Iy and the 6ℓ terms negated (θy = −w'). With Φ > 0 this is
+//! the shear-deformable element whose interpolation solves the static Timoshenko
+//! equations exactly (Przemieniecki, "Theory of Matrix Structural Analysis", 1968, §5.6).
 //!
 //! Lumping: each element gives each of its two end nodes half its mass, m_h = ρAℓ/2 (on
 //! u, v, w), the torsional inertia of half its length, ρ(Iy + Iz)ℓ/2 (on θx), and about y
-//! and z the inertia of its half-length rod about the node, m_h (ℓ/2)²/3 = ρAℓ³/24. The
-//! section's own rotary inertia ρIℓ/2 is left out about y and z, as Euler–Bernoulli theory
-//! leaves it out; the ρAℓ³/24 terms are positive, so M is positive definite, and they
-//! vanish as O(ℓ²) relative to the translational lumps (the lumped model converges to
-//! Euler–Bernoulli frequencies at O(h²)).
+//! and z the inertia of its half-length rod about the node, m_h (ℓ/2)²/3 = ρAℓ³/24, plus,
+//! for Timoshenko elements, the section's rotary inertia of half its length, ρIyℓ/2 and
+//! ρIzℓ/2. (Euler–Bernoulli theory leaves the section's rotary inertia out.) The ρAℓ³/24
+//! terms are positive, so M is positive definite, and they vanish as O(ℓ²) relative to
+//! the translational lumps: the lumped model converges to the continuous beam's
+//! frequencies at O(h²).
 
 use nalgebra::{DMatrix, DVector};
 
@@ -53,13 +58,22 @@ pub struct BeamFe {
     pub mass: DVector<f64>,
 }
 
-/// Assemble a beam of `length` made of `elements` equal elements.
-pub fn assemble(length: f64, elements: usize, s: &Section, m: &Material) -> BeamFe {
+/// Assemble a beam of `length` made of `elements` equal elements: Euler–Bernoulli, or
+/// Timoshenko with shear coefficient κ = `shear_coefficient`.
+pub fn assemble(length: f64, elements: usize, s: &Section, m: &Material, shear_coefficient: Option<f64>) -> BeamFe {
     let n = 6 * (elements + 1);
     let l = length / elements as f64;
-    let ke = element_stiffness(l, s, m);
+    let ke = element_stiffness(l, s, m, shear_coefficient);
     let half = m.density * s.area * l / 2.0;
-    let lump = [half, half, half, m.density * (s.iy + s.iz) * l / 2.0, half * l * l / 12.0, half * l * l / 12.0];
+    let rotary = |i: f64| if shear_coefficient.is_some() { m.density * i * l / 2.0 } else { 0.0 };
+    let lump = [
+        half,
+        half,
+        half,
+        m.density * (s.iy + s.iz) * l / 2.0,
+        half * l * l / 12.0 + rotary(s.iy),
+        half * l * l / 12.0 + rotary(s.iz),
+    ];
     let mut stiffness = DMatrix::zeros(n, n);
     let mut mass = DVector::zeros(n);
     for e in 0..elements {
@@ -79,8 +93,9 @@ pub fn assemble(length: f64, elements: usize, s: &Section, m: &Material) -> Beam
     BeamFe { x, stiffness, mass }
 }
 
-/// The 12 × 12 stiffness of one element of length `l`, DOFs [node 1; node 2].
-fn element_stiffness(l: f64, s: &Section, m: &Material) -> [[f64; 12]; 12] {
+/// The 12 × 12 stiffness of one element of length `l`, DOFs [node 1; node 2]; with a
+/// shear coefficient κ, shear-deformable (Timoshenko) bending.
+fn element_stiffness(l: f64, s: &Section, m: &Material, shear_coefficient: Option<f64>) -> [[f64; 12]; 12] {
     let mut k = [[0.0; 12]; 12];
     let mut pair = |dofs: [usize; 2], c: f64| {
         for (a, &i) in dofs.iter().enumerate() {
@@ -91,18 +106,15 @@ fn element_stiffness(l: f64, s: &Section, m: &Material) -> [[f64; 12]; 12] {
     };
     pair([0, 6], m.young * s.area / l);
     pair([3, 9], m.shear * s.j / l);
-    let hermite = |sign: f64| {
+    let bending = |sign: f64, phi: f64| {
         let c = sign * 6.0 * l;
-        [
-            [12.0, c, -12.0, c],
-            [c, 4.0 * l * l, -c, 2.0 * l * l],
-            [-12.0, -c, 12.0, -c],
-            [c, 2.0 * l * l, -c, 4.0 * l * l],
-        ]
+        let (near, far) = ((4.0 + phi) * l * l, (2.0 - phi) * l * l);
+        [[12.0, c, -12.0, c], [c, near, -c, far], [-12.0, -c, 12.0, -c], [c, far, -c, near]]
     };
     for (dofs, ei, sign) in [([1, 5, 7, 11], s.iz, 1.0), ([2, 4, 8, 10], s.iy, -1.0)] {
-        let h = hermite(sign);
-        let c = m.young * ei / l.powi(3);
+        let phi = shear_coefficient.map_or(0.0, |kappa| 12.0 * m.young * ei / (kappa * m.shear * s.area * l * l));
+        let h = bending(sign, phi);
+        let c = m.young * ei / ((1.0 + phi) * l.powi(3));
         for (a, &i) in dofs.iter().enumerate() {
             for (b, &j) in dofs.iter().enumerate() {
                 k[i][j] += c * h[a][b];
@@ -118,12 +130,19 @@ mod tests {
 
     /// K is symmetric, and rigid translations and rotations (about the beam's origin) give
     /// K r = 0 up to rounding (1e-12 relative to K's largest entry times |r|: sums of a
-    /// few terms of size max|K|·|r|); the lumped masses add up to ρAL.
+    /// few terms of size max|K|·|r|), for Euler–Bernoulli and (thick) Timoshenko elements;
+    /// the lumped masses add up to ρAL.
     #[test]
     fn stiffness_has_the_six_rigid_motions_as_null_space_and_masses_sum_up() {
-        let s = Section { area: 2e-4, iy: 3e-9, iz: 5e-9, j: 6e-9 };
+        for kappa in [None, Some(5.0 / 6.0)] {
+            rigid_null_space(kappa);
+        }
+    }
+
+    fn rigid_null_space(kappa: Option<f64>) {
+        let s = Section { area: 2e-2, iy: 3e-5, iz: 5e-5, j: 6e-5 };
         let m = Material { young: 2e11, shear: 8e10, density: 7800.0 };
-        let fe = assemble(1.5, 5, &s, &m);
+        let fe = assemble(1.5, 5, &s, &m, kappa);
         let k = &fe.stiffness;
         assert!((k - k.transpose()).amax() == 0.0);
         let n = fe.x.len();
@@ -147,6 +166,6 @@ mod tests {
             assert!((k * &v).amax() <= 1e-12 * k.amax() * v.amax(), "rigid motion {r}");
         }
         let total: f64 = (0..n).map(|i| fe.mass[6 * i]).sum();
-        assert!((total - 7800.0 * 2e-4 * 1.5).abs() <= 1e-12 * total);
+        assert!((total - 7800.0 * 2e-2 * 1.5).abs() <= 1e-12 * total);
     }
 }

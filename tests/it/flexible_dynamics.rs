@@ -23,6 +23,7 @@ fn soft_beam_of(elements: usize, modes: usize, clamp: Option<u32>) -> ModalData 
         damping: None,
         clamp,
         reduction: Reduction::FreeInterface,
+        shear_coefficient: None,
     };
     beam(&spec).unwrap()
 }

@@ -40,6 +40,7 @@ fn cantilever_beam(modes: usize, damping: Option<f64>) -> ModalData {
         damping,
         clamp: Some(0),
         reduction: Reduction::FreeInterface,
+        shear_coefficient: None,
     })
     .unwrap()
 }

@@ -106,6 +106,7 @@ fn setup_flexible(test: &str) -> (System, Layout, Vec<f64>) {
         damping: Some(0.02),
         clamp: None,
         reduction: Reduction::FreeInterface,
+        shear_coefficient: None,
     };
     let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("jacobians-flexible").join(test);
     std::fs::create_dir_all(&dir).unwrap();
