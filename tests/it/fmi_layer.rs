@@ -2,7 +2,7 @@
 //! those `mbfmu linearize` selects, they reach an instance from the FMU's resources (no
 //! engine run at fmi2Instantiate), and a missing or foreign layout is refused there.
 
-use crate::common::guid;
+use crate::common::{guid, guid_of};
 use mbfmu::fmi::exports_common::*;
 use mbfmu::fmi::pack::{LAYOUT_FILE, read_layout};
 use mbfmu::fmi::types::CO_SIMULATION;
@@ -41,9 +41,9 @@ fn temp_dir(name: &str) -> PathBuf {
     d
 }
 
-/// Every `*.xml` of `models/` and `tests/models/`, sorted.
+/// Every `*.xml` of `models/`, `models/flexible/` and `tests/models/`, sorted.
 fn all_models() -> Vec<PathBuf> {
-    let mut v: Vec<PathBuf> = ["models", "tests/models"]
+    let mut v: Vec<PathBuf> = ["models", "models/flexible", "tests/models"]
         .iter()
         .flat_map(|d| std::fs::read_dir(root().join(d)).expect("readable").map(|e| e.expect("entry").path()))
         .filter(|p| p.extension().is_some_and(|x| x == "xml"))
@@ -77,8 +77,7 @@ fn mbfmu_linearize_selects_the_states_the_fmu_lists_for_every_model() {
         assert!(o.status.success(), "{stem}: {}", text(&o.stderr));
         assert!(text(&o.stderr).is_empty(), "{stem} packs without warnings: {}", text(&o.stderr));
         // The FMU's states: its layout resource through variables(), as an instance sees them.
-        let model_text = std::fs::read_to_string(&path).expect("readable");
-        let layout = read_layout(&out.join("resources"), &guid(&model_text)).unwrap_or_else(|e| panic!("{e}"));
+        let layout = read_layout(&out.join("resources"), &guid_of(&path)).unwrap_or_else(|e| panic!("{e}"));
         let model = load_file(&path).unwrap_or_else(|e| panic!("{e}"));
         let fmu = fmu_states(&variables(&model, &layout));
         let xml = std::fs::read_to_string(out.join("modelDescription.xml")).expect("written");
@@ -210,11 +209,12 @@ fn a_missing_unreadable_or_foreign_layout_fails_instantiation_without_a_panic() 
 #[test]
 fn the_layout_file_reads_back_to_the_selection_at_start_for_every_model() {
     for path in all_models() {
-        let model_text = std::fs::read_to_string(&path).expect("readable");
-        let model = load_str(&model_text, "model.xml").unwrap_or_else(|e| panic!("{e}"));
-        let (bytes, warning) = mbfmu::fmi::pack::layout_file(&model_text, "model.xml").expect("a model");
+        // Under its own path: a flexible body's modal data file is found beside it.
+        let (model_text, label) = (std::fs::read_to_string(&path).expect("readable"), path.display().to_string());
+        let model = load_str(&model_text, &label).unwrap_or_else(|e| panic!("{e}"));
+        let (bytes, warning) = mbfmu::fmi::pack::layout_file(&model_text, &label).expect("a model");
         assert_eq!(warning, None, "{}", path.display());
-        let read = StateLayout::from_text(&text(&bytes), &guid(&model_text)).unwrap_or_else(|e| panic!("{e}"));
+        let read = StateLayout::from_text(&text(&bytes), &guid_of(&path)).unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(read, StateLayout::at_start(&model), "{}", path.display());
     }
 }

@@ -9,8 +9,8 @@
 //! `MBFMU_FMI_SEQUENCES` (default 300, what CI runs) sets how many sequences;
 //! `MBFMU_FMI_SEED` the base seed; `bench/fmi_sequences.sh` runs thousands.
 
-use crate::common::guid;
-use crate::common::host::{self, CALLBACKS, resources};
+use crate::common::guid_of;
+use crate::common::host::{self, CALLBACKS, resources_of};
 use crate::common::model_files;
 use mbfmu::fmi::exports_common::*;
 use mbfmu::fmi::exports_cs::*;
@@ -82,10 +82,9 @@ fn models() -> Vec<Model> {
     model_files()
         .iter()
         .map(|path| {
-            let text = std::fs::read_to_string(path).unwrap();
             let name = path.file_stem().unwrap().to_string_lossy().to_string();
-            let (_, uri) = resources(&text, "sequences");
-            let m = mbfmu::model::parse::load_str(&text, "model.xml").unwrap();
+            let (_, uri) = resources_of(path, "sequences");
+            let m = mbfmu::model::load_file(path).unwrap();
             let vars = variables(&m, &mbfmu::linearize::StateLayout::at_start(&m));
             let vr = |f: &dyn Fn(&mbfmu::fmi::variables::Variable) -> bool| {
                 vars.iter().filter(|v| f(v)).map(|v| v.value_reference).collect::<Vec<u32>>()
@@ -93,7 +92,7 @@ fn models() -> Vec<Model> {
             let max_steps = vars.iter().find(|v| v.target.is_integer()).map(|v| v.value_reference);
             Model {
                 uri,
-                guid: CString::new(guid(&text)).unwrap(),
+                guid: CString::new(guid_of(path)).unwrap(),
                 reals: vr(&|v| Some(v.value_reference) != max_steps),
                 parameters: vr(&|v| v.causality == Causality::Parameter && Some(v.value_reference) != max_steps),
                 inputs: vr(&|v| v.causality == Causality::Input),

@@ -16,10 +16,15 @@ fn example_variants() -> Vec<(String, Model)> {
     for path in model_files() {
         let file = path.file_name().unwrap().to_string_lossy().to_string();
         let text = std::fs::read_to_string(&path).unwrap();
-        out.push((file.clone(), load_str(&text, &file).unwrap()));
+        // Loaded under their own path: a flexible body's modal data file is found beside it.
+        let label = path.display().to_string();
+        out.push((file.clone(), load_str(&text, &label).unwrap_or_else(|e| panic!("{e}"))));
         if let (Some(a), Some(b)) = (text.find("<linearization>"), text.find("</linearization>")) {
             let bare = format!("{}{}", &text[..a], &text[b + "</linearization>".len()..]);
-            out.push((format!("{file} (no <linearization>)"), load_str(&bare, &file).unwrap()));
+            out.push((
+                format!("{file} (no <linearization>)"),
+                load_str(&bare, &label).unwrap_or_else(|e| panic!("{e}")),
+            ));
         }
     }
     out

@@ -34,12 +34,13 @@ ROTOR = """<?xml version="1.0" encoding="UTF-8"?>
 
 @pytest.fixture(scope="session")
 def packed(tmp_path_factory):
-    """packed(name) -> Packed: models/<name>.xml packed once (zip and unzipped)."""
+    """packed(name) -> Packed: models/<name>.xml packed once (zip and unzipped); `name` may
+    name a subdirectory (`flexible/suspension`)."""
     cache: dict[str, Packed] = {}
 
     def get(name: str) -> Packed:
         if name not in cache:
-            cache[name] = pack_model(MODELS / f"{name}.xml", tmp_path_factory.mktemp(name))
+            cache[name] = pack_model(MODELS / f"{name}.xml", tmp_path_factory.mktemp(name.replace("/", "-")))
         return cache[name]
 
     return get

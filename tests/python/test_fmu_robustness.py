@@ -14,9 +14,11 @@ from fmu_helpers import MODELS, LogCapture, _Logger6, fmi2CallbackLoggerTYPE, in
 
 FMI_ERROR = 3
 
-# Every example model; the run below initializes, steps, reads all of A/B/C/D and
-# round-trips the FMU state.
-EXAMPLES = sorted(p.stem for p in MODELS.glob("*.xml"))
+# Every example model (those with flexible bodies, in models/flexible/, included); the
+# run below initializes, steps, reads all of A/B/C/D and round-trips the FMU state.
+EXAMPLES = sorted(p.stem for p in MODELS.glob("*.xml")) + sorted(
+    f"flexible/{p.stem}" for p in (MODELS / "flexible").glob("*.xml")
+)
 
 # The whole run, in a thread whose stack is `stack` bytes, printed as JSON. It runs in a
 # child process so that a stack overflow shows as a failed test (exit by signal), not as

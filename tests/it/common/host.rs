@@ -199,6 +199,25 @@ pub fn state(c: Component) -> Option<State> {
     }
 }
 
+/// [`resources`] for the model file `path`, with its flexible bodies' modal data files
+/// copied into the resources under the paths the model gives (as `mbfmu pack` does).
+pub fn resources_of(path: &std::path::Path, tag: &str) -> (PathBuf, CString) {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let (top, uri) = resources(&text, tag);
+    let model = mbfmu::model::load_file(path).unwrap_or_else(|e| panic!("{e}"));
+    for flex in model.bodies.iter().filter_map(|b| b.flex.as_ref()) {
+        let to = top.join("resources").join(&flex.file);
+        if !to.exists() {
+            let dir = to.parent().expect("a file in resources/");
+            std::fs::create_dir_all(dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
+            let tmp = dir.join(format!("data.{:?}.tmp", std::thread::current().id()));
+            std::fs::copy(&flex.path, &tmp).unwrap_or_else(|e| panic!("{}: {e}", flex.path));
+            std::fs::rename(&tmp, &to).unwrap_or_else(|e| panic!("{}: {e}", to.display()));
+        }
+    }
+    (top, uri)
+}
+
 /// `<tmp>/mbfmu <tag> 100% <pid> <hash of text>/resources/model.xml` holding `text`, with the state
 /// layout `mbfmu pack` writes beside it (when the text is a model): the directory (remove
 /// it when done, if wanted) and the resource location's `file://` URI, with the space and

@@ -31,24 +31,25 @@ pub fn model_dir() -> PathBuf {
     root().join("models")
 }
 
-/// Every example model file, `models/*.xml`, sorted.
+/// Every example model file, `models/*.xml` then `models/flexible/*.xml`, each sorted.
+/// The flexible ones read modal data files beside them: load them by path
+/// ([`load_file`], [`guid_of`], `host::resources_of`), not from their text alone.
 pub fn model_files() -> Vec<PathBuf> {
-    let mut v: Vec<PathBuf> = std::fs::read_dir(model_dir())
-        .expect("models/ exists")
-        .map(|e| e.expect("readable models/ entry").path())
-        .filter(|p| p.extension().is_some_and(|x| x == "xml"))
-        .collect();
-    v.sort();
+    let mut v = xml_files(&model_dir());
+    v.extend(flexible_model_files());
     v
 }
 
-/// The example models with flexible bodies, `models/flexible/*.xml`, sorted: kept apart
-/// from [`model_files`] because their modal data files must travel with them (tests that
-/// copy a model's text elsewhere cannot take them).
+/// The example models with flexible bodies, `models/flexible/*.xml`, sorted.
 pub fn flexible_model_files() -> Vec<PathBuf> {
-    let mut v: Vec<PathBuf> = std::fs::read_dir(model_dir().join("flexible"))
-        .expect("models/flexible/ exists")
-        .map(|e| e.expect("readable models/flexible/ entry").path())
+    xml_files(&model_dir().join("flexible"))
+}
+
+/// The `*.xml` files of `dir`, sorted.
+fn xml_files(dir: &std::path::Path) -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .map(|e| e.expect("readable directory entry").path())
         .filter(|p| p.extension().is_some_and(|x| x == "xml"))
         .collect();
     v.sort();
@@ -72,6 +73,13 @@ pub fn guid(text: &str) -> String {
         Ok(m) => mbfmu::fmi::guid::guid(&m, text),
         Err(_) => "{not a model}".to_string(),
     }
+}
+
+/// The GUID `mbfmu pack` gives the FMU of the model file `path` (its modal data files
+/// read from beside it).
+pub fn guid_of(path: &std::path::Path) -> String {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    mbfmu::fmi::guid::guid(&load_file(path).unwrap_or_else(|e| panic!("{e}")), &text)
 }
 
 /// Run the `mbfmu` binary with `args` in the crate's root, without stdin.
