@@ -5,9 +5,9 @@ use super::layout::Layout;
 use super::sparse::Triplets;
 use crate::ad::chunked;
 use crate::mechanics::System;
-use crate::mechanics::body::{NQ, h_angular, qdot};
+use crate::mechanics::body::{NQ, h_angular};
 use crate::mechanics::constraint_jacobian::p_row;
-use crate::mechanics::coords::{gather, global_column, nql};
+use crate::mechanics::coords::{gather, global_column, nql, rates};
 use crate::mechanics::flexible;
 use crate::mechanics::kernels::{
     constraint_second, dhtw_dq, dqdot_dq, force_ext_jacobian, force_jacobian, gyroscopic, nonholonomic_second,
@@ -228,13 +228,8 @@ struct BodyRates {
 fn body_rates(sys: &System, bodies: &[usize], q: &[f64], u: &[f64]) -> BodyRates {
     let ql = gather(sys, bodies, q);
     let ul = gather(sys, bodies, u);
-    let mut qd = ul.clone();
-    let mut dq = Vec::with_capacity(bodies.len());
-    for kb in 0..bodies.len() {
-        let r = NQ * kb..NQ * kb + NQ;
-        qd[r.clone()].copy_from_slice(&qdot(&ql[r.clone()], &ul[r.clone()]));
-        dq.push(dqdot_dq(&ql[r.clone()], &ul[r]));
-    }
+    let qd = rates(bodies.len(), &ql, &ul);
+    let dq = (0..bodies.len()).map(|kb| dqdot_dq(&ql[NQ * kb..NQ * kb + NQ], &ul[NQ * kb..NQ * kb + NQ])).collect();
     BodyRates { qd, dq }
 }
 

@@ -149,12 +149,7 @@ impl Simulator {
         let n = self.dae.lay.n;
         let jerk = self.radau.derivatives_at_end().map(|(_, d2)| d2[n..2 * n].to_vec());
         let (q, u) = (self.q().to_vec(), self.u().to_vec());
-        // q̇ = H u body by body; the modal coordinates' rates are their velocities.
-        let nb = self.dae.sys.nb();
-        let qd: Vec<f64> = (0..nb)
-            .flat_map(|b| crate::mechanics::body::qdot(&q[NQ * b..NQ * b + NQ], &u[NQ * b..NQ * b + NQ]))
-            .chain(u[NQ * nb..].iter().copied())
-            .collect();
+        let qd = crate::mechanics::coords::rates(self.dae.sys.nb(), &q, &u);
         let mk = |v: &[f64], d: &[f64]| -> Vec<D> { v.iter().zip(d).map(|(&v, &d)| D { v, d: [d] }).collect() };
         let qv = mk(&q, &qd);
         let uv = mk(&u, &udot);

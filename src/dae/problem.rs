@@ -94,14 +94,8 @@ impl MultibodyDae {
             let sys = &self.sys;
             let ids: Vec<usize> = (0..sys.nb()).collect();
             type D1 = crate::ad::Dual<f64, 1>;
-            let mut qd: Vec<D1> = Vec::with_capacity(q.len());
-            let body_cols = sys.modal_columns().start;
-            for (qb, ub) in q[..body_cols].chunks_exact(NQ).zip(u[..body_cols].chunks_exact(NQ)) {
-                let rate = crate::mechanics::body::qdot(qb, ub);
-                qd.extend(qb.iter().zip(rate).map(|(&v, d)| D1 { v, d: [d] }));
-            }
-            // Modal coordinates: their rates are their velocities.
-            qd.extend(q[body_cols..].iter().zip(&u[body_cols..]).map(|(&v, &d)| D1 { v, d: [d] }));
+            let rates = crate::mechanics::coords::rates(sys.nb(), q, u);
+            let qd: Vec<D1> = q.iter().zip(rates).map(|(&v, d)| D1 { v, d: [d] }).collect();
             let ud: Vec<D1> = u.iter().map(|&v| D1::cst(v)).collect();
             let mut ctx = LocalCtx::new(sys, &ids, &qd, &ud, &[], D1 { v: t, d: [1.0] }, inputs);
             ctx.record = Some(&rec);

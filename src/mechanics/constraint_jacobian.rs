@@ -6,9 +6,9 @@
 //! Rows are numbered by the elements' `row` fields; every local entry is kept, zeros
 //! included, so the sparsity pattern does not change from one point to the next.
 
-use super::body::{NQ, h_transpose_times, qdot};
+use super::body::{NQ, h_transpose_times};
 use super::constraints::ConstraintEl;
-use super::coords::{gather, global_column, nql};
+use super::coords::{gather, global_column, nql, rates};
 use super::kernels::{constraint_first, constraint_second, dqdot_dq};
 use super::system::System;
 
@@ -135,16 +135,14 @@ pub fn acceleration_rhs(sys: &System, q: &[f64], u: &[f64], t: f64, inputs: &[f6
         let ql = gather(sys, &el.bodies, q);
         let ul = gather(sys, &el.bodies, u);
         // z' = (q̇, 1): γ = z'ᵀ ∇²C z' + C_q (∂q̇/∂q) q̇; modal rates are η̇ (H = I).
-        let mut zd = ul.clone();
+        let mut zd = rates(el.bodies.len(), &ql, &ul);
         zd.push(1.0);
         let mut extra = vec![0.0; nql];
         for kb in 0..el.bodies.len() {
             let r = NQ * kb..NQ * kb + NQ;
-            let qd = qdot(&ql[r.clone()], &ul[r.clone()]);
-            zd[r.clone()].copy_from_slice(&qd);
-            let dq = dqdot_dq(&ql[r.clone()], &ul[r]);
+            let dq = dqdot_dq(&ql[r.clone()], &ul[r.clone()]);
             for i in 0..NQ {
-                extra[NQ * kb + i] = (0..NQ).map(|c| dq[i * 6 + c] * qd[c]).sum();
+                extra[NQ * kb + i] = (0..NQ).map(|c| dq[i * 6 + c] * zd[NQ * kb + c]).sum();
             }
         }
         for e in 0..el.neq {

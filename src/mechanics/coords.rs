@@ -7,7 +7,7 @@
 //! body it touches (in its order), then the modal coordinates of those of them that are
 //! flexible. A rigid element's local block of body k is `6k..6k + 6` either way.
 
-use super::body::NQ;
+use super::body::{NQ, qdot};
 use super::system::System;
 use std::ops::Range;
 
@@ -52,4 +52,16 @@ pub fn gather(sys: &System, bodies: &[usize], x: &[f64]) -> Vec<f64> {
 pub fn local_modal_range(sys: &System, bodies: &[usize], k: usize) -> Range<usize> {
     let start = NQ * bodies.len() + bodies[..k].iter().map(|&b| sys.modal_range(b).len()).sum::<usize>();
     start..start + sys.modal_range(bodies[k]).len()
+}
+
+/// q̇ of coordinates `q` with velocities `u` in this layout, global or an element's local
+/// one with `nbodies` bodies: H(q_b) u_b for each body's six, then the modal coordinates'
+/// rates, which are their velocities (H = I there).
+pub fn rates(nbodies: usize, q: &[f64], u: &[f64]) -> Vec<f64> {
+    let mut qd = u.to_vec();
+    for b in 0..nbodies {
+        let r = NQ * b..NQ * b + NQ;
+        qd[r.clone()].copy_from_slice(&qdot(&q[r.clone()], &u[r]));
+    }
+    qd
 }

@@ -24,7 +24,7 @@ pub struct ConstraintFirst {
     pub ct: Vec<f64>,
 }
 
-/// C with gradient and Hessian over z = (local q, t); K = 6nb + 1.
+/// C with gradient and Hessian over z = (local q, t); K = nq + 1 (nq local coordinates).
 pub struct ConstraintSecond {
     /// Number K of variables z.
     pub k: usize,
@@ -34,6 +34,13 @@ pub struct ConstraintSecond {
     pub grad: Vec<f64>,
     /// neq × K × K.
     pub hess: Vec<f64>,
+}
+
+impl ConstraintSecond {
+    /// All zero, for `neq` equations of `k` variables.
+    fn zeros(k: usize, neq: usize) -> Self {
+        ConstraintSecond { k, c: vec![0.0; neq], grad: vec![0.0; neq * k], hess: vec![0.0; neq * k * k] }
+    }
 }
 
 /// Constraint values only.
@@ -80,8 +87,7 @@ fn first_k<const K: usize>(
 /// Second derivatives of a constraint element (for Ċ_q, (Pᵀλ)_q and the γ of Eq. 1c).
 pub fn constraint_second(sys: &System, el: &ConstraintEl, q: &[f64], t: f64, inputs: &[f64]) -> ConstraintSecond {
     let k = nql(sys, &el.bodies) + 1;
-    let mut r =
-        ConstraintSecond { k, c: vec![0.0; el.neq], grad: vec![0.0; el.neq * k], hess: vec![0.0; el.neq * k * k] };
+    let mut r = ConstraintSecond::zeros(k, el.neq);
     by_width!(k, second_k, [1, 7, 13, 19](sys, el, q, t, inputs, &mut r));
     r
 }
@@ -170,8 +176,9 @@ fn nh_first_k<const K: usize>((sys, el, q, u, t, ext): NhArgs, r: &mut Nonholono
 
 /// g of a non-holonomic element with its gradient over z = (local q, local u, t) and the
 /// mixed second derivatives ∂²g/∂u∂(q, t) (what (Bᵀν)_q needs), in the layout of
-/// [`ConstraintSecond`] with K = 12nb + 1; the (q, q) and (u, u) blocks are left zero
-/// (g is linear in u). Nested duals: outer over u (6nb), inner over (q, t).
+/// [`ConstraintSecond`] with K = 2nq + 1; the (q, q) and (u, u) blocks are left zero
+/// (g is linear in u). Nested duals: outer over u, inner over (q, t), each seeded a
+/// chunk at a time past 18 coordinates.
 pub fn nonholonomic_second(
     sys: &System,
     el: &NonholonomicEl,
@@ -182,8 +189,7 @@ pub fn nonholonomic_second(
 ) -> ConstraintSecond {
     let nq = nql(sys, &el.bodies);
     let k = 2 * nq + 1;
-    let mut r =
-        ConstraintSecond { k, c: vec![0.0; el.neq], grad: vec![0.0; el.neq * k], hess: vec![0.0; el.neq * k * k] };
+    let mut r = ConstraintSecond::zeros(k, el.neq);
     let mut go = |f: fn(NhArgs, &mut ConstraintSecond, Range<usize>, Range<usize>), w: usize| {
         for cu in chunks(nq, w) {
             for cq in chunks(nq + 1, w + 1) {

@@ -2,8 +2,7 @@
 //! B = ∂g/∂u with g, and the γ of their acceleration form B u̇ + γ = 0, assembled in this
 //! one place for every user.
 
-use super::body::{NQ, qdot};
-use super::coords::{gather, global_column};
+use super::coords::{gather, global_column, rates};
 use super::kernels::nonholonomic_first;
 use super::system::System;
 
@@ -15,12 +14,7 @@ pub fn nonholonomic_gamma(sys: &System, q: &[f64], u: &[f64], t: f64, ext: &[f64
         let s = nonholonomic_first(sys, el, q, u, t, ext);
         let nql = crate::mechanics::coords::nql(sys, &el.bodies);
         let (ql, ul) = (gather(sys, &el.bodies, q), gather(sys, &el.bodies, u));
-        // q̇ = H u for the six coordinates of each body, η̇ for the modal ones.
-        let mut qd = ul.clone();
-        for kb in 0..el.bodies.len() {
-            let r = NQ * kb..NQ * kb + NQ;
-            qd[r.clone()].copy_from_slice(&qdot(&ql[r.clone()], &ul[r]));
-        }
+        let qd = rates(el.bodies.len(), &ql, &ul);
         for e in 0..el.neq {
             let g = &s.grad[e * s.k..(e + 1) * s.k];
             gamma[el.row + e] = (0..nql).map(|a| g[a] * qd[a]).sum::<f64>() + g[2 * nql];

@@ -10,9 +10,9 @@
 use mbfmu::dae::equations::{Layout, jacobian, rhs};
 use mbfmu::dae::sparse::Triplets;
 use mbfmu::mechanics::System;
-use mbfmu::mechanics::body::{NQ, qdot};
+use mbfmu::mechanics::body::NQ;
 use mbfmu::mechanics::constraint_jacobian::{acceleration_rhs, p_row};
-use mbfmu::mechanics::coords::{gather, nql};
+use mbfmu::mechanics::coords::{gather, nql, rates};
 use mbfmu::mechanics::kernels::constraint_first;
 use mbfmu::model::parse::load_str;
 
@@ -183,13 +183,6 @@ fn random_state(sys: &System, lay: Layout, eta: f64) -> Vec<f64> {
     y
 }
 
-/// q̇ = H(q) u for every body, η̇ for the modal coordinates.
-fn qdot_all(sys: &System, q: &[f64], u: &[f64]) -> Vec<f64> {
-    let mut qd: Vec<f64> = (0..sys.nb()).flat_map(|b| qdot(&q[NQ * b..NQ * b + NQ], &u[NQ * b..NQ * b + NQ])).collect();
-    qd.extend_from_slice(&u[NQ * sys.nb()..]);
-    qd
-}
-
 #[test]
 fn jacobian_of_the_equations_of_motion_matches_central_differences() {
     jacobian_matches_central_differences(setup());
@@ -275,7 +268,7 @@ fn gamma_is_the_second_time_derivative_of_the_constraints((sys, lay, y): (System
         }
         out
     };
-    let qd = qdot_all(&sys, q, u);
+    let qd = rates(sys.nb(), q, u);
     let h = 1e-5;
     let shift = |s: f64| -> (Vec<f64>, Vec<f64>) {
         // Second-order accurate point on the trajectory: q(t+s) ≈ q + s q' + s²/2 q''; the
@@ -322,7 +315,7 @@ fn nonholonomic_gamma_is_the_time_derivative_of_g((sys, lay, y): (System, Layout
     let ext = lay.ext(&sys, &INPUTS, &y, t);
     let mut seed = 5;
     let a: Vec<f64> = (0..lay.n).map(|_| rng(&mut seed)).collect();
-    let qd = qdot_all(&sys, q, u);
+    let qd = rates(sys.nb(), q, u);
     let h = 1e-5;
     let at = |s: f64| -> Vec<f64> {
         let qs: Vec<f64> = (0..lay.n).map(|i| q[i] + s * qd[i]).collect();
