@@ -36,17 +36,17 @@ impl Simulator {
         let mut u = sys.u_init.clone();
         let assembly_tol = (opts.tol * 1e-3).max(1e-14);
         sys.redundant = init::redundant_rows(&sys, &q, t0, &inputs);
-        init::assemble_positions(&sys, &mut q, t0, &inputs, assembly_tol).map_err(|e| match e.element {
-            Some(b) => EngineError::Model(ModelError {
-                file: model.file.clone(),
-                pos: b.0.pos,
-                element: b.0.tag.into(),
-                name: b.0.name.clone(),
-                msg: if b.0.neq > 1 { format!("{} (equation {} of {})", e.msg, b.1, b.0.neq) } else { e.msg },
-            }),
-            None => EngineError::Numeric(e.msg),
-        })?;
-        let (sys_q0, assembled) = (sys.q_init.clone(), q.clone());
+        let assembly =
+            init::assemble_positions(&mut sys, &mut q, t0, &inputs, assembly_tol).map_err(|e| match e.element {
+                Some(b) => EngineError::Model(ModelError {
+                    file: model.file.clone(),
+                    pos: b.0.pos,
+                    element: b.0.tag.into(),
+                    name: b.0.name.clone(),
+                    msg: if b.0.neq > 1 { format!("{} (equation {} of {})", e.msg, b.1, b.0.neq) } else { e.msg },
+                }),
+                None => EngineError::Numeric(e.msg),
+            })?;
         let mut z = vec![0.0; lay.nz()];
         z[..lay.nx].copy_from_slice(&sys.x_init);
         if model.static_analysis {
@@ -67,7 +67,7 @@ impl Simulator {
             radau.max_step = h;
         }
         radau.max_steps = opts.max_steps.max(1);
-        let warnings = assembly_moves(model, &sys_q0, &assembled);
+        let warnings = assembly_moves(model, &dae.sys.q_init, &assembly);
         Ok(Simulator { dae, radau, acc_lu, acc: Some((udot, lam)), warnings })
     }
 

@@ -23,11 +23,13 @@
 //! - [`loads`]: element loads `fx(name)` … and their exact gradients.
 //! - [`external_values`]: [`System::ext`], the external values at a state.
 //! - [`components`]: connected components of the mechanism.
+//! - [`angles`]: re-based Euler frames and recorded angle branches (what motion changes).
 //! - [`mass`]: the mass matrix M(q) (Eq. 1a), body by body.
 //! - [`constraint_jacobian`]: the one assembly of C_q, its transpose, the velocity form P
 //!   and the filter of redundant rows (Eq. 1b–1c).
 //! - [`nonholonomic_jacobian`]: B and γ of the non-holonomic rows (Eq. 7).
 
+pub mod angles;
 pub mod body;
 pub mod components;
 pub mod constraint_equations;

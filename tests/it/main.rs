@@ -12,6 +12,7 @@ mod common;
 mod algebraic_loop;
 mod architecture;
 mod assembly;
+mod assembly_branches;
 mod bicycle_benchmark;
 mod bounded_step;
 mod bushing;

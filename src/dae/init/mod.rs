@@ -1,8 +1,10 @@
 //! Initialization (MODEL_FORMAT "Initial conditions"), one step per file, in the order
 //! a simulation start runs them:
 //! - [`redundancy`]: which constraint rows depend on others (their λ = 0);
-//! - [`positions`]: assemble positions with the smallest change (Gauss–Newton,
-//!   minimum-norm corrections [I C_qᵀ; C_q 0]);
+//! - [`positions`]: assemble positions with the smallest change: the drawing made
+//!   consistent ([`gauss_newton`], least-norm corrections [I C_qᵀ; C_q 0]), then the
+//!   exact conditions reached along a path ([`continuation`]), every joint's orientation
+//!   checked ([`orientation`]);
 //! - [`statics`]: static equilibrium instead, when the model asks for it;
 //! - [`velocities`]: consistent velocities closest to the given ones (P u + C_t = 0,
 //!   B u + b = 0, the velocity ICs);
@@ -15,7 +17,10 @@
 
 pub mod accelerations;
 pub mod algebraic_loop;
+mod continuation;
+mod gauss_newton;
 mod kkt;
+mod orientation;
 pub mod positions;
 pub mod redundancy;
 pub mod statics;
@@ -24,7 +29,7 @@ pub mod velocities;
 
 pub use accelerations::accelerations;
 pub use algebraic_loop::consistent_accelerations;
-pub use positions::{InitError, assemble_positions};
+pub use positions::{Assembly, InitError, assemble_positions};
 pub use redundancy::{REDUNDANCY_TOL, redundant_rows};
 pub use statics::static_equilibrium;
 pub use user_unknowns::user_unknowns;
