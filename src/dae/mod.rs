@@ -19,6 +19,7 @@ pub mod residual;
 mod simulator;
 mod snapshot;
 pub mod sparse;
+mod start_values;
 
 pub use error::EngineError;
 pub use observe::BodyState;
@@ -26,3 +27,4 @@ pub use options::SimOptions;
 pub use radau::{BATCH_MAX_STEPS, DEFAULT_MAX_STEPS};
 pub use simulator::Simulator;
 pub use snapshot::SimState;
+pub use start_values::{START_VALUE_TAG, StartValue, StartValues};

@@ -8,6 +8,7 @@ use super::options::SimOptions;
 use super::problem::MultibodyDae;
 use super::radau::{DaeProblem, Radau, Stats};
 use super::sparse::SparseLu;
+use super::start_values::{START_VALUE_TAG, StartValues};
 use crate::mechanics::System;
 use crate::model::{Model, ModelError};
 
@@ -29,7 +30,14 @@ impl Simulator {
     /// Build the equations and initialize at `t0` (assembly, consistent velocities,
     /// accelerations and multipliers).
     pub fn new(model: &Model, opts: SimOptions, t0: f64) -> Result<Simulator, EngineError> {
+        Self::with_start(model, opts, t0, &StartValues::default())
+    }
+
+    /// [`Simulator::new`] with values set on states, met exactly (see [`StartValues`]); a
+    /// set that cannot be met is an error naming the values.
+    pub fn with_start(model: &Model, opts: SimOptions, t0: f64, start: &StartValues) -> Result<Simulator, EngineError> {
         let mut sys = System::from_model(model).map_err(EngineError::Numeric)?;
+        start.apply(&mut sys);
         let inputs: Vec<f64> = model.inputs.iter().map(|i| i.start.value).collect();
         let lay = Layout::of(&sys);
         let mut q = sys.q_init.clone();
@@ -38,6 +46,10 @@ impl Simulator {
         sys.redundant = init::redundant_rows(&sys, &q, t0, &inputs);
         let assembly =
             init::assemble_positions(&mut sys, &mut q, t0, &inputs, assembly_tol).map_err(|e| match e.element {
+                Some(b) if b.0.tag == START_VALUE_TAG => EngineError::Numeric(format!(
+                    "the start values set cannot be met: {} '{}': {}",
+                    b.0.tag, b.0.name, e.msg
+                )),
                 Some(b) => EngineError::Model(ModelError {
                     file: model.file.clone(),
                     pos: b.0.pos,

@@ -10,7 +10,10 @@ use super::state_machine::State;
 use super::types::Status;
 use super::variables::{Target, Variable, variables};
 use crate::dae::{DEFAULT_MAX_STEPS, SimOptions, SimState, Simulator};
-use crate::linearize::{Linearization, Selection, StateLayout, linearize, selection_by_name, state_values};
+use crate::dae::StartValues;
+use crate::linearize::{
+    Linearization, Selection, StateLayout, StateTarget, linearize, selection_by_name, start_values, state_values,
+};
 use crate::model::Model;
 
 /// The engine, with the configuration it was built from.
@@ -58,6 +61,9 @@ pub struct Instance {
     pub last_time: f64,
     /// The FMU states handed to the host and not yet freed.
     pub states: StateHandles,
+    /// Start values the host set on states before initialization ended: (value reference,
+    /// value), each state once, in the order first set; met exactly by initialization.
+    pub starts: Vec<(u32, f64)>,
 }
 
 impl Instance {
@@ -80,6 +86,7 @@ impl Instance {
             dirty: true,
             last_time,
             states: StateHandles::default(),
+            starts: Vec::new(),
         }
     }
 
@@ -98,6 +105,7 @@ impl Instance {
     /// fmi2Reset: back to the state after fmi2Instantiate (logging settings kept).
     pub fn reset(&mut self) {
         self.config = Self::default_config(&self.base);
+        self.starts.clear();
         self.built = None;
         self.dirty = true;
         self.last_time = self.config.start;
@@ -159,9 +167,10 @@ impl Instance {
         for (i, &v) in model.inputs.iter_mut().zip(&cfg.inputs) {
             i.start.value = v;
         }
-        let mut sim =
-            Simulator::new(&model, SimOptions { tol: cfg.tol, max_step: None, max_steps: cfg.max_steps }, cfg.start)
-                .map_err(|e| format!("the model cannot be initialized: {e}"))?;
+        let start = self.start_values(&model)?;
+        let opts = SimOptions { tol: cfg.tol, max_step: None, max_steps: cfg.max_steps };
+        let mut sim = Simulator::with_start(&model, opts, cfg.start, &start)
+            .map_err(|e| format!("the model cannot be initialized: {e}"))?;
         for (k, &s) in cfg.slopes.iter().enumerate() {
             if s != 0.0 {
                 sim.set_input_derivative(k, s);
@@ -169,6 +178,36 @@ impl Instance {
         }
         let sel = selection_by_name(sim.system(), &self.layout);
         Ok(Built { sim, params: cfg.params.clone(), tol: cfg.tol, sel, lin: None })
+    }
+
+    /// The start values set on states, as conditions on the system of `model`.
+    fn start_values(&self, model: &Model) -> Result<StartValues, String> {
+        if self.starts.is_empty() {
+            return Ok(StartValues::default());
+        }
+        let mut set = Vec::with_capacity(self.starts.len());
+        for &(vr, v) in &self.starts {
+            let var = self.var(vr)?;
+            set.push((var.name.clone(), self.state_target(var)?, v));
+        }
+        let sys = crate::mechanics::System::from_model(model)?;
+        start_values(&sys, &self.layout, &set)
+    }
+
+    /// The state a start value on `var` sets (Err: it is not a settable state).
+    fn state_target(&self, var: &Variable) -> Result<StateTarget, String> {
+        match var.target {
+            Target::State(k) => Ok(StateTarget::Position(k)),
+            Target::StateDerivative(k) => self.layout.velocity_of_state(k).map(StateTarget::Velocity).ok_or_else(|| {
+                format!(
+                    "'{}' is a derivative, not a state (the model's non-holonomic constraints fix it): set its velocity states",
+                    var.name
+                )
+            }),
+            Target::Velocity(j) => Ok(StateTarget::Velocity(j)),
+            Target::Diff(k) => Ok(StateTarget::Differential(k)),
+            _ => Err(format!("'{}' is not a state", var.name)),
+        }
     }
 
     /// The variable of value reference `vr`, which must be of FMI type Integer (`integer`)
@@ -307,13 +346,21 @@ impl Instance {
             }
             match var.target {
                 Target::Output(_) => return Err(format!("'{}' (vr {vr}) is an output and cannot be set", var.name)),
-                Target::State(_) | Target::StateDerivative(_) | Target::Velocity(_) | Target::VelocityDerivative(_) => {
+                Target::State(_) | Target::StateDerivative(_) | Target::Velocity(_) | Target::Diff(_)
+                    if self.initialized() =>
+                {
                     return Err(format!(
-                        "'{}' (vr {vr}) is a linearization state (computed from the motion) and cannot be set",
-                        var.name
+                        "state '{}' (vr {vr}) cannot be set after initialization (state {:?}): its start value is \
+                         set before fmi2ExitInitializationMode; later states follow the motion (fmi2SetFMUstate \
+                         restores a saved one)",
+                        var.name, self.state
                     ));
                 }
-                Target::Diff(_) | Target::DiffDerivative(_) | Target::UserVariable(_) => {
+                Target::State(_) | Target::StateDerivative(_) | Target::Velocity(_) | Target::Diff(_) => {
+                    self.state_target(var).map_err(|e| format!("{e} (vr {vr}) and cannot be set"))?;
+                    targets.push((var.target, v));
+                }
+                Target::VelocityDerivative(_) | Target::DiffDerivative(_) | Target::UserVariable(_) => {
                     return Err(format!("'{}' (vr {vr}) is computed by the engine and cannot be set", var.name));
                 }
                 Target::Parameter(_) if self.initialized() => {
@@ -326,8 +373,15 @@ impl Instance {
             }
         }
         let mut moved = false;
-        for (t, v) in targets {
+        for (&vr, (t, v)) in vrs.iter().zip(targets) {
             match t {
+                Target::State(_) | Target::StateDerivative(_) | Target::Velocity(_) | Target::Diff(_) => {
+                    match self.starts.iter_mut().find(|s| s.0 == vr) {
+                        Some(s) => s.1 = v,
+                        None => self.starts.push((vr, v)),
+                    }
+                    self.dirty = true;
+                }
                 Target::Parameter(k) => {
                     self.config.params[k] = v;
                     self.dirty = true;

@@ -18,6 +18,7 @@ pub mod rhs;
 pub mod select;
 pub mod select_velocity;
 pub mod sensitivity;
+pub mod start;
 pub mod states;
 pub mod structure;
 pub mod tiers;
@@ -28,6 +29,7 @@ pub use candidates::Candidates;
 pub use layout::{StateInfo, StateLayout, selection_by_name};
 pub use linearization::Linearization;
 pub use select::{Selection, select_states, select_states_among};
+pub use start::{StateTarget, start_values};
 pub use states::derivative_name;
 pub use structure::{Dependencies, ModelStructure};
 

@@ -5,9 +5,9 @@
 
 use super::jets::{PositionFn, jets};
 use crate::ad::Real;
-use crate::geom::{M3, euler313_from_matrix};
 use crate::mechanics::System;
 use crate::mechanics::local::LocalCtx;
+pub use crate::mechanics::measures::StateKind;
 use crate::model::expr::{Expr, deps};
 
 /// The name of the time derivative of the quantity named `name`: `der(name)`, the FMI
@@ -123,44 +123,6 @@ pub fn user_velocities(sys: &System) -> Vec<UserVelocity> {
         .collect()
 }
 
-/// What a state measures.
-#[derive(Clone, Debug, PartialEq)]
-pub enum StateKind {
-    /// A `<linearization><state>` expression.
-    User {
-        /// The expression s(q, t).
-        f: Expr,
-        /// Its angle-unwrapping slot base.
-        abase: usize,
-    },
-    /// A joint's free coordinate (`sys.joint_coords`).
-    Joint {
-        /// The coordinate as an expression.
-        f: Expr,
-        /// Its angle-unwrapping slot base.
-        abase: usize,
-        /// What it measures, frame stated.
-        about: String,
-    },
-    /// CM coordinate k (x, y, z) of a body, ground frame.
-    Position {
-        /// 0, 1, 2: x, y, z.
-        k: usize,
-    },
-    /// Modal coordinate k of a flexible body.
-    Modal {
-        /// 0-based mode index.
-        k: usize,
-    },
-    /// 3-1-3 angle k (ψ, θ, φ) of a body relative to the fixed frame `r0`.
-    Angle {
-        /// 0, 1, 2: ψ, θ, φ.
-        k: usize,
-        /// The body's reference frame, fixed at selection time.
-        r0: [[f64; 3]; 3],
-    },
-}
-
 /// One linearization state.
 #[derive(Clone, Debug, PartialEq)]
 pub struct StateFn {
@@ -180,12 +142,7 @@ impl PositionFn for StateFn {
         1
     }
     fn eval<T: Real>(&self, ctx: &LocalCtx<T>, out: &mut [T]) {
-        out[0] = match &self.kind {
-            StateKind::User { f, abase } | StateKind::Joint { f, abase, .. } => ctx.eval_expr(f, *abase),
-            StateKind::Position { k } => ctx.bodies[0].r.0[*k],
-            StateKind::Modal { k } => ctx.modal_coordinate(0, *k),
-            StateKind::Angle { k, r0 } => euler313_from_matrix(&M3::cst(r0).t().mm(&ctx.bodies[0].a))[*k],
-        };
+        out[0] = self.kind.eval(ctx);
     }
 }
 

@@ -1,7 +1,7 @@
 //! The equations of the holonomic constraint elements (Eq. 1a) and of the velocity
 //! initial conditions, evaluated in an element context.
 
-use super::constraints::{ConstraintKind, VelocityIc};
+use super::constraints::{ConstraintKind, VelocityIc, VelocityIcKind};
 use super::local::LocalCtx;
 use super::nonholonomic_equations::wheel_contact;
 use crate::ad::Real;
@@ -29,6 +29,7 @@ impl ConstraintKind {
                 let (pc, n, o, _) = wheel_contact(ctx, *m, *radius, *plane);
                 out[0] = (pc - o).dot(&n);
             }
+            ConstraintKind::State { kind, value } => out[0] = kind.eval(ctx) - T::cst(*value),
         }
     }
 }
@@ -53,11 +54,20 @@ fn joint_equations<T: Real>(kind: JointType, ctx: &LocalCtx<T>, i: MarkerId, j: 
 }
 
 impl VelocityIc {
-    /// Residual (ω_i − ω_j)·z_j − value, or (v_i − v_j)·z_j − value.
+    /// Residual (ω_i − ω_j)·z_j − value, (v_i − v_j)·z_j − value, or w(q, u, t) − value.
+    /// A [`VelocityIcKind::Rate`] has no such form here (it reads as NaN): its row comes
+    /// from the measure's gradient (`dae::init::velocities`).
     pub fn eval<T: Real>(&self, ctx: &LocalCtx<T>) -> T {
-        let zj = ctx.pose(self.j).r.col(2);
-        let (a, b) = (ctx.twist(self.i), ctx.twist(self.j));
-        let rel = if self.angular { a.w - b.w } else { a.v - b.v };
-        rel.dot(&zj) - T::cst(self.value)
+        let rel = match &self.kind {
+            VelocityIcKind::Joint { angular, i, j } => {
+                let zj = ctx.pose(*j).r.col(2);
+                let (a, b) = (ctx.twist(*i), ctx.twist(*j));
+                let rel = if *angular { a.w - b.w } else { a.v - b.v };
+                rel.dot(&zj)
+            }
+            VelocityIcKind::User { f, abase } => ctx.eval_expr(f, *abase),
+            VelocityIcKind::Rate(_) => T::cst(f64::NAN),
+        };
+        rel - T::cst(self.value)
     }
 }

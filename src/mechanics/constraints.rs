@@ -2,6 +2,7 @@
 //! and the exact joint initial conditions used during assembly. Their equations are in
 //! [`super::constraint_equations`].
 
+use super::measures::StateKind;
 use crate::model::expr::{Expr, MarkerId};
 use crate::model::{JointType, SrcPos};
 
@@ -18,6 +19,8 @@ pub enum ConstraintKind {
     User { f: Expr, abase: usize },
     /// A rolling wheel's contact point stays on its plane: (P − o)·n = 0.
     WheelContact { m: MarkerId, radius: f64, plane: Option<MarkerId> },
+    /// A start value set on a state: its measure equals `value` (assembly only).
+    State { kind: StateKind, value: f64 },
 }
 
 /// One constraint element: its equations occupy rows `row..row+neq` of C.
@@ -57,19 +60,28 @@ impl ConstraintKind {
     }
 }
 
-/// A velocity-level initial condition (exact `ic_angular_speed` / `ic_speed`), linear in u.
+/// A velocity-level initial condition, linear in u: exact `ic_angular_speed` /
+/// `ic_speed`, or a start value set on a velocity state.
 #[derive(Clone, Debug)]
 pub struct VelocityIc {
-    /// Name of the joint it belongs to.
+    /// Name of the joint or state it belongs to.
     pub name: String,
-    /// Relative angular velocity about z_j (true) or relative velocity along z_j (false).
-    pub angular: bool,
-    /// The joint's i marker.
-    pub i: MarkerId,
-    /// The joint's j marker.
-    pub j: MarkerId,
+    /// What it sets.
+    pub kind: VelocityIcKind,
     /// Prescribed value.
     pub value: f64,
-    /// Bodies of the joint's markers (global indices).
+    /// Bodies it reads (global indices).
     pub bodies: Vec<usize>,
+}
+
+/// What a velocity-level initial condition sets.
+#[derive(Clone, Debug)]
+pub enum VelocityIcKind {
+    /// A joint's relative angular velocity about z_j (`angular`) or relative velocity
+    /// along z_j, of its markers i and j.
+    Joint { angular: bool, i: MarkerId, j: MarkerId },
+    /// The time derivative of a position-level measure (a state's `der(S)`).
+    Rate(StateKind),
+    /// A user velocity expression w(q, u, t), linear in u (a `<velocity>` state).
+    User { f: Expr, abase: usize },
 }

@@ -6,7 +6,7 @@
 //! states and velocities, in this order.
 
 use super::body::{FAR_FROM_SINGULAR, NQ, rebased_reference};
-use super::constraints::{ConstraintEl, ConstraintKind, VelocityIc};
+use super::constraints::{ConstraintEl, ConstraintKind, VelocityIc, VelocityIcKind};
 use super::external::ExtLayout;
 use super::forces::{ForceEl, ForceKind};
 use super::joint_coords::{JointCoord, joint_coordinates};
@@ -265,9 +265,7 @@ fn joints_and_ics(model: &Model, markers: &[MarkerGeom]) -> (Vec<ConstraintEl>, 
             if let Some(v) = v {
                 ic_velocities.push(VelocityIc {
                     name: jt.name.clone(),
-                    angular,
-                    i: jt.i,
-                    j: jt.j,
+                    kind: VelocityIcKind::Joint { angular, i: jt.i, j: jt.j },
                     value: v.value,
                     bodies: bl.clone(),
                 });

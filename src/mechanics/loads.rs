@@ -267,7 +267,9 @@ fn constraint_load<T: Real>(
         ConstraintKind::Joint { i, j, .. }
         | ConstraintKind::Rotation { i, j, .. }
         | ConstraintKind::Translation { i, j, .. } => (*i, *j),
-        ConstraintKind::User { .. } | ConstraintKind::WheelContact { .. } => return None,
+        ConstraintKind::User { .. } | ConstraintKind::WheelContact { .. } | ConstraintKind::State { .. } => {
+            return None;
+        }
     };
     if el.bodies.is_empty() {
         return None;

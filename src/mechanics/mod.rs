@@ -7,6 +7,7 @@
 //! - [`body`]: body coordinates q, u, the map H = T⁻¹ and the reference frames R0.
 //! - [`load_components`]: the six components of an element load and their order.
 //! - [`joint_coords`]: the free coordinates of each joint, as expressions.
+//! - [`measures`]: what a linearization state measures (and a start value sets), data.
 //! - [`constraints`]: holonomic constraint elements and velocity initial conditions (data).
 //! - [`nonholonomic`]: non-holonomic constraint elements (data).
 //! - [`forces`]: force elements (data).
@@ -15,6 +16,7 @@
 //! - [`external`]: layout of the external values [inputs; Z; L] ([`external::ExtLayout`]).
 //! - [`from_model`]: [`System::from_model`], step by step.
 //! - [`local`]: the element context [`local::LocalCtx`] that element equations read.
+//! - [`measure_values`]: the value of a measure in an element context.
 //! - [`nonholonomic_equations`]: equations g of the non-holonomic elements, wheel contact.
 //! - [`constraint_equations`]: equations C of the constraint elements and velocity ICs.
 //! - [`force_laws`]: loads and generalized forces of the force elements.
@@ -48,6 +50,8 @@ pub mod load_components;
 pub mod loads;
 pub mod local;
 pub mod mass;
+pub mod measure_values;
+pub mod measures;
 pub mod nonholonomic;
 pub mod nonholonomic_equations;
 pub mod nonholonomic_jacobian;

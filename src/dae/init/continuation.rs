@@ -1,5 +1,5 @@
 //! The way from the drawn pose to the exact conditions: the drives (exact joint ICs
-//! `ic_angle` / `ic_displacement` and motions at t0) are moved together from the values
+//! `ic_angle` / `ic_displacement`, motions at t0, start values set on states) are moved together from the values
 //! they have in the drawn (joint-consistent) pose to their targets in small steps, each
 //! solved by Newton from the last, so that assembly follows the mechanism's own branch
 //! (continuation in the target values). A step is taken again at half the size when
@@ -19,7 +19,9 @@ use crate::mechanics::coords::gather;
 use crate::mechanics::forces::ForceKind;
 use crate::mechanics::local::LocalCtx;
 use crate::model::SpringType;
+use crate::mechanics::measures::StateKind;
 use crate::model::expr::{Expr, ExprEnv, KinFn};
+use crate::model::units;
 
 /// Largest change of an exact angle in one step (rad).
 pub(super) const ANGLE_STEP: f64 = std::f64::consts::PI / 16.0;
@@ -54,7 +56,7 @@ pub(super) struct Drive {
 
 /// Whether element `el` is a drive (its value is set by the model, not by the drawing).
 pub(super) fn is_drive(el: &ConstraintEl) -> bool {
-    matches!(el.kind, ConstraintKind::Rotation { .. } | ConstraintKind::Translation { .. })
+    matches!(el.kind, ConstraintKind::Rotation { .. } | ConstraintKind::Translation { .. } | ConstraintKind::State { .. })
 }
 
 /// The drives among `els`, measured at q (the drawn pose made consistent with the joints).
@@ -73,6 +75,17 @@ pub(super) fn drives(sys: &System, els: &[ConstraintEl], q: &[f64], t: f64, inpu
                 let (a, b) = (ctx.pose(*i), ctx.pose(*j));
                 ((a.p - b.p).dot(&b.r.col(2)), ctx.eval_expr(f, *abase), false)
             }
+            // A state's measure is continuous (angles unwrapped along the way): the way
+            // goes straight to the value, whole turns included. Steps of a length are
+            // sized as displacements, of anything else as angles (in its own unit).
+            ConstraintKind::State { kind, value } => {
+                let length = matches!(kind, StateKind::Position { .. })
+                    || matches!(kind, StateKind::Joint { f, .. } | StateKind::User { f, .. }
+                        if units::of_expr(f) == Some("m"));
+                let start = kind.eval(&ctx);
+                out.push(Drive { index, start, end: *value, target: *value, angular: !length });
+                continue;
+            }
             _ => continue,
         };
         let two_pi = 2.0 * std::f64::consts::PI;
@@ -89,7 +102,8 @@ fn at(els: &[ConstraintEl], drives: &[Drive], s: f64) -> Vec<ConstraintEl> {
         let v = if s >= 1.0 { d.end } else { d.start + s * (d.end - d.start) };
         match &mut out[d.index].kind {
             ConstraintKind::Rotation { f, .. } | ConstraintKind::Translation { f, .. } => *f = Expr::Num(v),
-            _ => unreachable!("a drive is a rotation or a translation"),
+            ConstraintKind::State { value, .. } => *value = v,
+            _ => unreachable!("a drive is a rotation, a translation or a state"),
         }
     }
     out

@@ -6,6 +6,8 @@ use super::kkt::push_p_blocks;
 use crate::ad::{Dual, Real, chunked};
 use crate::dae::sparse::{SparseLu, Triplets};
 use crate::mechanics::System;
+use crate::mechanics::constraint_jacobian::p_row;
+use crate::mechanics::constraints::{VelocityIc, VelocityIcKind};
 use crate::mechanics::coords::{gather, global_column};
 use crate::mechanics::local::LocalCtx;
 use crate::mechanics::nonholonomic_jacobian::nonholonomic_b;
@@ -35,12 +37,7 @@ pub fn assemble_velocities(sys: &System, q: &[f64], u: &mut [f64], t: f64, input
         rhs[nh0 + r] += v * u[c];
     }
     for (k, ic) in sys.ic_velocities.iter().enumerate() {
-        // Linear in u: residual(u) = a·u − value; a from dual numbers seeded on u.
-        let ql = gather(sys, &ic.bodies, q);
-        let (res, a) = chunked::jacobian(&gather(sys, &ic.bodies, u), |ul| {
-            let ql: Vec<_> = ql.iter().map(|&v| Dual::cst(v)).collect();
-            vec![ic.eval(&LocalCtx::new(sys, &ic.bodies, &ql, ul, &[], Dual::cst(t), inputs))]
-        });
+        let (res, a) = velocity_ic_row(sys, ic, q, u, t, inputs);
         let r = ic0 + k;
         let mut au = 0.0;
         for (c, &d) in a.iter().enumerate() {
@@ -49,13 +46,49 @@ pub fn assemble_velocities(sys: &System, q: &[f64], u: &mut [f64], t: f64, input
             kkt.push(g, r, d);
             au += d * u[g];
         }
-        rhs[r] = au - res[0];
+        rhs[r] = au - res;
     }
+    // Velocity conditions that conflict with each other or with the constraints make the
+    // system singular: name them.
+    let conditions = || {
+        let names: Vec<String> = sys.ic_velocities.iter().map(|ic| format!("'{}' = {}", ic.name, ic.value)).collect();
+        if names.is_empty() { String::new() } else { format!(" (velocity conditions: {})", names.join(", ")) }
+    };
     let mut lu = SparseLu::new();
-    lu.factor(dim, &kkt).map_err(|e| format!("cannot make velocities consistent: {e}"))?;
+    lu.factor(dim, &kkt).map_err(|e| format!("cannot make velocities consistent: {e}{}", conditions()))?;
     if !lu.solve(&mut rhs) {
-        return Err("cannot make velocities consistent: singular velocity constraints".into());
+        return Err(format!("cannot make velocities consistent: singular velocity constraints{}", conditions()));
     }
     u.copy_from_slice(&rhs[..n]);
     Ok(())
+}
+
+/// A velocity IC as a row linear in the local u: (residual at `u`, coefficients a).
+/// Joint and user-expression kinds: a from dual numbers seeded on u. The rate of a
+/// position measure s(q, t): ṡ = s_q H u + s_t, so a = s_q H (as P = C_q H, Eq. 13a)
+/// and the residual a·u + s_t − value.
+fn velocity_ic_row(sys: &System, ic: &VelocityIc, q: &[f64], u: &[f64], t: f64, inputs: &[f64]) -> (f64, Vec<f64>) {
+    let ql = gather(sys, &ic.bodies, q);
+    let ul = gather(sys, &ic.bodies, u);
+    match &ic.kind {
+        VelocityIcKind::Rate(kind) => {
+            let mut x = ql.clone();
+            x.push(t);
+            let nq = ql.len();
+            let (_, g) = chunked::jacobian(&x, |xl| {
+                let ctx = LocalCtx::new(sys, &ic.bodies, &xl[..nq], &[], &[], xl[nq], inputs);
+                vec![kind.eval(&ctx)]
+            });
+            let a = p_row(&ic.bodies, q, &g[..nq]);
+            let sdot: f64 = a.iter().zip(&ul).map(|(x, y)| x * y).sum::<f64>() + g[nq];
+            (sdot - ic.value, a)
+        }
+        _ => {
+            let (res, a) = chunked::jacobian(&ul, |ul| {
+                let ql: Vec<_> = ql.iter().map(|&v| Dual::cst(v)).collect();
+                vec![ic.eval(&LocalCtx::new(sys, &ic.bodies, &ql, ul, &[], Dual::cst(t), inputs))]
+            });
+            (res[0], a)
+        }
+    }
 }
