@@ -41,11 +41,15 @@ def cli() -> Path:
     )
 
 
-def pack(model, out=None, out_dir=None) -> Path:
+def pack(model, out=None, out_dir=None, start_values=None) -> Path:
     """Pack `model` (an mbfmu model file) into the FMU `out` (default: the model's name
     with .fmu beside it); `out_dir` also writes the unzipped FMU there. Returns `out`.
-    A model error is raised as ArgumentError with the tool's `file:line:col` message; what
-    the packed FMU lacks (the tool's warnings) is issued as a PackWarning."""
+    `start_values` (a dict parameter name -> float) replaces the file's values as the FMU's
+    start values (`mbfmu pack --set name=value`: every attribute using them re-evaluated;
+    the modelDescription's `start` and an instance's defaults). A model error, an unknown
+    name (with a "did you mean" when one is close) or a value the model rejects is raised
+    as ArgumentError with the tool's message; what the packed FMU lacks (the tool's
+    warnings) is issued as a PackWarning."""
     model = Path(model)
     if not model.is_file():
         raise FMUNotFoundError(f"model file '{model}' does not exist")
@@ -53,6 +57,13 @@ def pack(model, out=None, out_dir=None) -> Path:
     args = [str(cli()), "pack", str(model), "-o", str(out)]
     if out_dir is not None:
         args += ["--out-dir", str(out_dir)]
+    for name, value in (start_values or {}).items():
+        try:
+            number = float(value)
+        except (TypeError, ValueError):
+            raise ArgumentError(f"start value of '{name}': {value!r} is not a number") from None
+        # repr of a float reads back exactly in the tool (Rust's f64 parser).
+        args += ["--set", f"{name}={number!r}"]
     r = subprocess.run(args, capture_output=True, text=True)
     if r.returncode == 2:
         raise ArgumentError(r.stderr.strip())

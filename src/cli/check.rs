@@ -6,15 +6,14 @@
 use std::io::Write;
 use std::path::Path;
 
-use super::CliError;
+use super::{CliError, SetArgs};
 use crate::dae::Simulator;
 use crate::dae::counts::{Counts, counts};
 use crate::linearize::tolerances::selection_options;
-use crate::model::parse::load_file;
 
-/// Load, validate and assemble `path`, then print the model name and its counts to `out`.
-pub fn check(path: &Path, out: &mut dyn Write) -> Result<(), CliError> {
-    let model = load_file(path)?;
+/// Load, validate and assemble `path` (with the `--set` overrides), then print the model name and its counts to `out`.
+pub fn check(path: &Path, set: &SetArgs, out: &mut dyn Write) -> Result<(), CliError> {
+    let model = set.load(path)?;
     let t0 = model.experiment.start.unwrap_or(0.0);
     let sim = Simulator::new(&model, selection_options(), t0)?;
     super::print_warnings(&sim);

@@ -8,13 +8,12 @@ use std::path::PathBuf;
 
 use clap::Args;
 
-use super::CliError;
 use super::input_csv::InputTable;
+use super::{CliError, SetArgs};
 use crate::dae::{BATCH_MAX_STEPS, SimOptions, Simulator};
 use crate::linearize::eigen::{eigen_table, format_table};
 use crate::linearize::{Linearization, Selection, linearize, selection_at_start, state_values};
 use crate::model::Model;
-use crate::model::parse::load_file;
 
 /// Integration tolerance when neither `--tol` nor the model's experiment gives one.
 pub const DEFAULT_TOL: f64 = 1e-8;
@@ -48,6 +47,9 @@ pub struct LinearizeArgs {
     /// rows, as fmpy's input arrays).
     #[arg(long, value_name = "FILE")]
     pub input: Option<PathBuf>,
+    /// Parameter values to use instead of the file's.
+    #[command(flatten)]
+    pub set: SetArgs,
     /// Threads for the right-hand sides of the augmented system.
     #[arg(long, default_value_t = 2)]
     pub threads: usize,
@@ -57,7 +59,7 @@ pub struct LinearizeArgs {
 /// except with `--format json` and no `--out`: then `out` gets only the JSON and the
 /// report goes to `report` (stderr), so the output pipes into a JSON reader.
 pub fn run(args: &LinearizeArgs, out: &mut dyn Write, report: &mut dyn Write) -> Result<(), CliError> {
-    let mut model = load_file(&args.model)?;
+    let mut model = args.set.load(&args.model)?;
     // --static: start from static equilibrium, as <analysis static="true"/> does.
     model.static_analysis |= args.r#static;
     let t0 = model.experiment.start.unwrap_or(0.0);

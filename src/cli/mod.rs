@@ -19,7 +19,7 @@ mod simulate;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand};
+use clap::{Args, Parser, Subcommand};
 
 pub use error::CliError;
 pub use linearize::LinearizeArgs;
@@ -44,6 +44,9 @@ pub enum Command {
     Check {
         /// Model file (XML, see MODEL_FORMAT.md).
         model: PathBuf,
+        /// Parameter values to use instead of the file's.
+        #[command(flatten)]
+        set: SetArgs,
     },
     /// Simulate a model and write time, every output (and with --states every q and u)
     /// as CSV.
@@ -99,6 +102,40 @@ pub fn main() -> ExitCode {
     }
 }
 
+/// `--set NAME=VALUE` (repeatable): start values instead of the model file's (today: model
+/// parameters), shared by `check`, `simulate`, `linearize` and `pack`. Parsed and resolved
+/// by [`crate::model::overrides`], so that every command reads them alike.
+#[derive(Clone, Debug, Default, Args)]
+pub struct SetArgs {
+    /// Use VALUE for the parameter NAME (repeatable): every attribute using it is
+    /// re-evaluated, as when an FMU's parameter is set before initialization.
+    #[arg(long = "set", value_name = "NAME=VALUE")]
+    pub set: Vec<String>,
+}
+
+impl SetArgs {
+    /// The `NAME=VALUE` pairs; a malformed one is a usage error (exit 2).
+    pub fn pairs(&self) -> Result<Vec<(String, f64)>, CliError> {
+        self.set
+            .iter()
+            .map(|s| crate::model::overrides::parse_assignment(s).map_err(|e| CliError::Usage(format!("--set {e}"))))
+            .collect()
+    }
+
+    /// Load the model file `path` with these overrides applied (an unknown name, a name set
+    /// twice or a value the model rejects: a usage error, exit 2).
+    pub fn load(&self, path: &std::path::Path) -> Result<crate::model::Model, CliError> {
+        let model = crate::model::parse::load_file(path)?;
+        let pairs = self.pairs()?;
+        if pairs.is_empty() {
+            return Ok(model);
+        }
+        let usage = |e: String| CliError::Usage(format!("--set: {e}"));
+        let overrides = model.resolve_overrides(&pairs).map_err(usage)?;
+        model.with_overrides(&overrides).map_err(usage)
+    }
+}
+
 /// Print the engine's initialization warnings (bodies that assembly moved far) to stderr.
 pub(crate) fn print_warnings(sim: &crate::dae::Simulator) {
     for w in sim.warnings() {
@@ -111,7 +148,7 @@ pub fn execute(command: &Command) -> Result<(), CliError> {
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     match command {
-        Command::Check { model } => check::check(model, &mut out),
+        Command::Check { model, set } => check::check(model, set, &mut out),
         Command::Simulate(args) => simulate::simulate(args, &mut out),
         Command::Pack(args) => pack::run(args, &mut out),
         Command::Linearize(args) => linearize::run(args, &mut out, &mut std::io::stderr().lock()),

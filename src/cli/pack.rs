@@ -6,8 +6,8 @@ use std::path::PathBuf;
 
 use clap::{ArgGroup, Args};
 
-use super::CliError;
-use crate::fmi::pack::{PackError, pack};
+use super::{CliError, SetArgs};
+use crate::fmi::pack::{PackError, pack_with};
 
 /// Arguments of `mbfmu pack` (at least one of `--out` and `--out-dir`).
 #[derive(Clone, Debug, Args)]
@@ -21,12 +21,17 @@ pub struct PackArgs {
     /// Write the FMU's files, unzipped, into this directory.
     #[arg(long, value_name = "DIR")]
     pub out_dir: Option<PathBuf>,
+    /// Start values instead of the file's: the FMU's default (and modelDescription
+    /// `start`) of each parameter set.
+    #[command(flatten)]
+    pub set: SetArgs,
 }
 
 impl From<PackError> for CliError {
     fn from(e: PackError) -> Self {
         match e {
             PackError::Model(m) => CliError::Model(m),
+            PackError::StartValue(e) => CliError::Usage(format!("--set: {e}")),
             PackError::Io { context, source } => CliError::Io { context, source },
             PackError::LibraryNotFound(msg) => {
                 CliError::io("locating the FMU library", std::io::Error::new(std::io::ErrorKind::NotFound, msg))
@@ -38,7 +43,7 @@ impl From<PackError> for CliError {
 /// Pack the FMU and print one line: modelIdentifier, GUID and where it was written (and
 /// what the FMU lacks, as warnings on stderr).
 pub fn run(args: &PackArgs, out: &mut dyn Write) -> Result<(), CliError> {
-    let packed = pack(&args.model, args.out.as_deref(), args.out_dir.as_deref())?;
+    let packed = pack_with(&args.model, &args.set.pairs()?, args.out.as_deref(), args.out_dir.as_deref())?;
     packed.warnings.iter().for_each(|w| eprintln!("warning: {w}"));
     let dest: Vec<String> = args.out.iter().chain(&args.out_dir).map(|p| p.display().to_string()).collect();
     writeln!(out, "packed FMU '{}' guid {} -> {}", packed.model_identifier, packed.guid, dest.join(", "))

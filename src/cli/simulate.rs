@@ -7,11 +7,10 @@ use std::path::PathBuf;
 
 use clap::Args;
 
-use super::CliError;
 use super::input_csv::InputTable;
+use super::{CliError, SetArgs};
 use crate::dae::{DEFAULT_MAX_STEPS, SimOptions, Simulator};
 use crate::model::Model;
-use crate::model::parse::load_file;
 
 /// Defaults when neither the command line nor the model's `<experiment>` gives a value.
 const DEFAULT_STOP: f64 = 1.0;
@@ -49,6 +48,9 @@ pub struct SimulateArgs {
     /// rows, as fmpy's input arrays).
     #[arg(long, value_name = "FILE")]
     pub input: Option<PathBuf>,
+    /// Parameter values to use instead of the file's.
+    #[command(flatten)]
+    pub set: SetArgs,
 }
 
 /// Start, end, step and tolerance of one simulation run.
@@ -170,7 +172,7 @@ fn write_csv_row(out: &mut dyn Write, t: f64, values: &[f64]) -> std::io::Result
 
 /// Run `mbfmu simulate`; the CSV goes to `--out` or else to `stdout`.
 pub fn simulate(args: &SimulateArgs, stdout: &mut dyn Write) -> Result<(), CliError> {
-    let mut model = load_file(&args.model)?;
+    let mut model = args.set.load(&args.model)?;
     model.static_analysis |= args.r#static;
     let settings = RunSettings::resolve(&model, args.end, args.step, args.tol)?;
     let points = settings.points()?;

@@ -8,7 +8,6 @@
 #![allow(non_snake_case)]
 
 use super::guard::{get, guarded, slice, slice_mut, text, with_stack};
-use super::guid::guid;
 use super::handle::{create, destroy};
 use super::instance::Instance;
 use super::logger::{Logger, Sink};
@@ -92,7 +91,8 @@ pub unsafe extern "C" fn fmi2Instantiate(
     made.unwrap_or(std::ptr::null_mut())
 }
 
-/// Check the arguments and read the model and its linearization states.
+/// Check the arguments and read the model (with its packed start values applied, see
+/// [`super::pack::read_start_values`]) and its linearization states.
 ///
 /// # Safety
 /// `guid_p` and `res_p` are NULL or NUL-terminated.
@@ -118,7 +118,8 @@ unsafe fn instantiate(
         std::fs::read_to_string(&file).map_err(|e| fail(format!("cannot read {}: {e}", file.display())))?;
     let model = crate::model::parse::load_str(&model_text, &file.display().to_string())
         .map_err(|e| fail(format!("invalid model: {e}")))?;
-    let own = guid(&model, &model_text);
+    let (model, own) =
+        super::pack::read_start_values(&dir, model, &model_text).map_err(|e| fail(format!("bad start values: {e}")))?;
     if given != own {
         return Err(fail(format!("fmuGUID {given} does not match this FMU's {own} (model {})", file.display())));
     }

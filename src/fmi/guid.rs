@@ -1,6 +1,7 @@
 //! Identity of an FMU: its GUID (a hash of the model text, the modal data of its flexible
-//! bodies and the engine version, so a changed model, modal data or engine gives a new
-//! GUID) and its modelIdentifier (from the model name).
+//! bodies, the start values packed with it and the engine version, so a changed model,
+//! modal data, start value or engine gives a new GUID) and its modelIdentifier (from the
+//! model name).
 
 use crate::model::Model;
 
@@ -31,9 +32,19 @@ pub fn checksum(bytes: &[u8]) -> u64 {
 /// The modal data of the flexible bodies enter by their values
 /// ([`Model::modal_data_texts`]), not their files' formatting.
 pub fn guid(model: &Model, model_text: &str) -> String {
+    guid_with(model, model_text, "")
+}
+
+/// The GUID of the FMU of `model` packed with the start values `start_values` (the text of
+/// its `resources/start_values.txt`, [`crate::model::overrides::start_values_text`]; empty:
+/// none, and then the GUID is [`guid`]'s).
+pub fn guid_with(model: &Model, model_text: &str, start_values: &str) -> String {
     let modal = model.modal_data_texts();
     let mut parts = vec![ENGINE_VERSION.as_bytes(), model_text.as_bytes()];
     parts.extend(modal.iter().map(|m| m.as_bytes()));
+    if !start_values.is_empty() {
+        parts.extend([b"start_values".as_slice(), start_values.as_bytes()]);
+    }
     let h = fnv1a128(&parts);
     let s = format!("{h:032x}");
     format!("{{{}-{}-{}-{}-{}}}", &s[0..8], &s[8..12], &s[12..16], &s[16..20], &s[20..32])
@@ -66,5 +77,10 @@ mod tests {
         assert!(a.starts_with('{') && a.ends_with('}'));
         assert_eq!(model_identifier("double pendulum-2"), "double_pendulum_2");
         assert_eq!(model_identifier("2d"), "_2d");
+        let m = crate::model::parse::load_str("<multibody name=\"a\" version=\"1\"/>", "m.xml").unwrap();
+        let text = "<multibody name=\"a\" version=\"1\"/>";
+        assert_eq!(guid_with(&m, text, ""), a);
+        assert_ne!(guid_with(&m, text, "x=1\n"), a);
+        assert_ne!(guid_with(&m, text, "x=1\n"), guid_with(&m, text, "x=2\n"));
     }
 }

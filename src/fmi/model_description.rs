@@ -19,20 +19,21 @@ use crate::model::Model;
 /// [`describe`].
 pub fn write(model: &Model, model_text: &str) -> String {
     let FmuLinearization { layout, structure } = for_fmu(model);
-    describe(model, model_text, &layout, &structure)
+    describe(model, &guid(model, model_text), &layout, &structure)
 }
 
-/// The modelDescription.xml of the FMU of `model`, whose file text is `model_text` (it
-/// determines the GUID, see [`guid`]), with the linearization states `layout` and the
-/// dependencies `structure` (of the same selection, see [`for_fmu`]).
-pub fn describe(model: &Model, model_text: &str, layout: &StateLayout, structure: &ModelStructure) -> String {
+/// The modelDescription.xml of the FMU of `model` with the GUID `guid` (see
+/// [`super::guid`]; `model` is the model as the FMU starts, start values applied), the
+/// linearization states `layout` and the dependencies `structure` (of the same selection,
+/// see [`for_fmu`]).
+pub fn describe(model: &Model, guid: &str, layout: &StateLayout, structure: &ModelStructure) -> String {
     let vars = variables(model, layout);
     let mut x = String::new();
     x.push_str("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
     x.push_str("<fmiModelDescription\n");
     attr_line(&mut x, "fmiVersion", "2.0");
     attr_line(&mut x, "modelName", &model.name);
-    attr_line(&mut x, "guid", &guid(model, model_text));
+    attr_line(&mut x, "guid", guid);
     attr_line(&mut x, "description", &format!("Multibody model {}", model.name));
     attr_line(&mut x, "generationTool", &format!("mbfmu {ENGINE_VERSION}"));
     attr_line(&mut x, "variableNamingConvention", "structured");

@@ -5,7 +5,15 @@
 //! binaries/<platform>/<modelIdentifier>.<ext>   a copy of this crate's cdylib
 //! resources/model.xml                           the model file, byte for byte
 //! resources/states.txt                          the linearization states (StateLayout)
+//! resources/start_values.txt                    with `--set`: the start values, `name=value`
 //! ```
+//!
+//! Start values (`mbfmu pack --set NAME=VALUE`, [`crate::model::overrides`]) replace the
+//! model file's parameter values as the FMU's defaults: modelDescription.xml's `start`,
+//! the state selection and the values of an instance not told otherwise all come from the
+//! model with them applied, while `resources/model.xml` stays the user's file byte for
+//! byte; an instance applies `resources/start_values.txt` at fmi2Instantiate
+//! ([`read_start_values`]), and the GUID covers it ([`guid_with`]).
 //!
 //! The linearization states are selected once, here (an engine run,
 //! [`crate::linearize::for_fmu`]); an instance reads them back with [`read_layout`]
@@ -23,13 +31,17 @@ use std::path::{Path, PathBuf};
 use zip::CompressionMethod;
 use zip::write::SimpleFileOptions;
 
-use super::guid::{guid, model_identifier};
+use super::guid::{guid, guid_with, model_identifier};
 use super::model_description;
 use crate::linearize::{FmuLinearization, StateLayout, for_fmu};
-use crate::model::{ModelError, load_str};
+use crate::model::overrides::{parse_start_values, start_values_text};
+use crate::model::{Model, ModelError, load_str};
 
 /// The state layout's file in the FMU's resources directory.
 pub const LAYOUT_FILE: &str = "states.txt";
+
+/// The start values' file in the FMU's resources directory (only when packed with some).
+pub const START_VALUES_FILE: &str = "start_values.txt";
 
 /// FMI platform folder under `binaries/`.
 #[cfg(target_os = "macos")]
@@ -50,6 +62,10 @@ pub enum PackError {
     /// The model file does not load (bad input).
     #[error("{0}")]
     Model(#[from] ModelError),
+    /// A start value is unusable: unknown name, set twice, or rejected by the model (bad
+    /// input).
+    #[error("{0}")]
+    StartValue(String),
     /// The FMU's shared library was not found.
     #[error("{0}")]
     LibraryNotFound(String),
@@ -140,8 +156,8 @@ pub fn library() -> Result<Vec<u8>, PackError> {
     std::fs::read(&path).map_err(io_err(format!("reading {}", path.display())))
 }
 
-/// Load the model and gather every file of its FMU.
-fn contents(model_path: &Path) -> Result<Contents, PackError> {
+/// Load the model and gather every file of its FMU, with the start values `set`.
+fn contents(model_path: &Path, set: &[(String, f64)]) -> Result<Contents, PackError> {
     let label = model_path.display().to_string();
     let bytes = std::fs::read(model_path).map_err(|e| ModelError {
         file: label.clone(),
@@ -157,12 +173,15 @@ fn contents(model_path: &Path) -> Result<Contents, PackError> {
         name: label.clone(),
         msg: format!("not UTF-8: {e}"),
     })?;
-    let model = load_str(text, &label)?;
+    let base = load_str(text, &label)?;
+    let overrides = base.resolve_overrides(set).map_err(PackError::StartValue)?;
+    let model = base.with_overrides(&overrides).map_err(PackError::StartValue)?;
+    let start_values = start_values_text(&overrides);
     let id = model_identifier(&model.name);
     let lib = library()?;
     let FmuLinearization { layout, structure } = for_fmu(&model);
-    let xml = model_description::describe(&model, text, &layout, &structure);
-    let guid = guid(&model, text);
+    let guid = guid_with(&base, text, &start_values);
+    let xml = model_description::describe(&model, &guid, &layout, &structure);
     let warnings = layout
         .missing
         .iter()
@@ -174,6 +193,9 @@ fn contents(model_path: &Path) -> Result<Contents, PackError> {
         ("resources/model.xml".to_string(), bytes.clone()),
         (format!("resources/{LAYOUT_FILE}"), layout.to_text(&guid).into_bytes()),
     ];
+    if !start_values.is_empty() {
+        files.push((format!("resources/{START_VALUES_FILE}"), start_values.into_bytes()));
+    }
     files.extend(modal_files(&model)?);
     Ok(Contents { packed: Packed { guid, model_identifier: id, warnings }, files })
 }
@@ -234,9 +256,31 @@ pub fn read_layout(resources: &Path, guid: &str) -> Result<StateLayout, String> 
     StateLayout::from_text(&text, guid).map_err(|e| format!("{}: {e}", file.display()))
 }
 
+/// The model of the FMU whose resources directory is `resources`, read from `model_text`
+/// (`base`), with its start values applied, and its GUID (read at fmi2Instantiate). No
+/// `start_values.txt`: `base` and its plain GUID. A malformed file, an unknown name or a
+/// value the model rejects is an error naming the file.
+pub fn read_start_values(resources: &Path, base: Model, model_text: &str) -> Result<(Model, String), String> {
+    let file = resources.join(START_VALUES_FILE);
+    let text = match std::fs::read_to_string(&file) {
+        Ok(t) => t,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            let own = guid(&base, model_text);
+            return Ok((base, own));
+        }
+        Err(e) => return Err(format!("cannot read {}: {e}", file.display())),
+    };
+    let bad = |e: String| format!("{}: {e}", file.display());
+    let pairs = parse_start_values(&text).map_err(bad)?;
+    let overrides = base.resolve_overrides(&pairs).map_err(bad)?;
+    let own = guid_with(&base, model_text, &start_values_text(&overrides));
+    let model = base.with_overrides(&overrides).map_err(bad)?;
+    Ok((model, own))
+}
+
 /// Write the FMU of the model file `model_path` as the zip archive `out` (replacing it).
 pub fn pack_fmu(model_path: &Path, out: &Path) -> Result<Packed, PackError> {
-    let c = contents(model_path)?;
+    let c = contents(model_path, &[])?;
     write_zip(&c, out)?;
     Ok(c.packed)
 }
@@ -244,14 +288,25 @@ pub fn pack_fmu(model_path: &Path, out: &Path) -> Result<Packed, PackError> {
 /// Write the FMU of the model file `model_path` unzipped into the directory `dir`
 /// (created if needed; files of the same names are replaced).
 pub fn pack_dir(model_path: &Path, dir: &Path) -> Result<Packed, PackError> {
-    let c = contents(model_path)?;
+    let c = contents(model_path, &[])?;
     write_dir(&c, dir)?;
     Ok(c.packed)
 }
 
 /// Pack both ways at once (either may be `None`); the model is loaded once.
 pub fn pack(model_path: &Path, fmu: Option<&Path>, dir: Option<&Path>) -> Result<Packed, PackError> {
-    let c = contents(model_path)?;
+    pack_with(model_path, &[], fmu, dir)
+}
+
+/// [`pack`] with the start values `set` (`NAME=VALUE` pairs, [`crate::model::overrides`])
+/// instead of the model file's values.
+pub fn pack_with(
+    model_path: &Path,
+    set: &[(String, f64)],
+    fmu: Option<&Path>,
+    dir: Option<&Path>,
+) -> Result<Packed, PackError> {
+    let c = contents(model_path, set)?;
     if let Some(out) = fmu {
         write_zip(&c, out)?;
     }

@@ -3,11 +3,13 @@
 
 pub mod error;
 pub mod expr;
+pub mod overrides;
 pub mod parse;
 mod types;
 pub mod units;
 
 pub use error::ModelError;
+pub use overrides::{Override, OverrideTarget};
 pub use parse::{Summary, load_file, load_str, rotation, try_rotation};
 pub use types::*;
 

@@ -18,6 +18,7 @@ mod bounded_step;
 mod bushing;
 mod cli;
 mod cli_linearize;
+mod cli_set;
 mod dependencies;
 mod elements;
 mod expr_derivatives;

@@ -88,6 +88,23 @@ pub unsafe fn instantiate(
     visible: c_int,
     logging_on: c_int,
 ) -> Component {
+    // SAFETY: per this function's contract.
+    unsafe { instantiate_logged(name, fmu_type, guid, resources, visible, logging_on) }.0
+}
+
+/// [`instantiate`], also returning the messages logged during fmi2Instantiate (those of a
+/// refused instantiation, which leaves no component to ask [`messages`] with).
+///
+/// # Safety
+/// As [`instantiate`].
+pub unsafe fn instantiate_logged(
+    name: FmiString,
+    fmu_type: c_int,
+    guid: FmiString,
+    resources: FmiString,
+    visible: c_int,
+    logging_on: c_int,
+) -> (Component, Vec<String>) {
     let log: Arc<Log> = Arc::default();
     // SAFETY: the six-argument logger is called as the variadic type with exactly the
     // arguments it declares (see `record`); the pointer types have one size.
@@ -103,10 +120,11 @@ pub unsafe fn instantiate(
     };
     // SAFETY: per this function's contract; the FMU copies the callbacks.
     let c = unsafe { fmi2Instantiate(name, fmu_type, guid, resources, &callbacks, visible, logging_on) };
+    let logged = lock(&log).clone();
     if !c.is_null() {
         lock(&LOGS).insert(c as usize, log);
     }
-    c
+    (c, logged)
 }
 
 /// fmi2FreeInstance, and the instance's log with it (out of LOGS first, while the
