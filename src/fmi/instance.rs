@@ -9,8 +9,8 @@ use super::state_handles::StateHandles;
 use super::state_machine::State;
 use super::types::Status;
 use super::variables::{Target, Variable, variables};
-use crate::dae::{DEFAULT_MAX_STEPS, SimOptions, SimState, Simulator};
 use crate::dae::StartValues;
+use crate::dae::{DEFAULT_MAX_STEPS, SimOptions, SimState, Simulator};
 use crate::linearize::{
     Linearization, Selection, StateLayout, StateTarget, linearize, selection_by_name, start_values, state_values,
 };

@@ -11,23 +11,29 @@ use std::fmt::Write as _;
 
 use super::guid::{ENGINE_VERSION, guid, model_identifier};
 use super::variables::{Causality, Target, Variable, variables};
-use crate::linearize::{Dependencies, FmuLinearization, ModelStructure, StateLayout, for_fmu};
+use crate::linearize::{Dependencies, FmuLinearization, ModelStructure, StateLayout, StateValues, for_fmu};
 use crate::model::Model;
 
 /// The modelDescription.xml that `mbfmu pack` writes for `model`, whose file text is
 /// `model_text`: its linearization decided by [`for_fmu`] (an engine run), then
 /// [`describe`].
 pub fn write(model: &Model, model_text: &str) -> String {
-    let FmuLinearization { layout, structure } = for_fmu(model);
-    describe(model, &guid(model, model_text), &layout, &structure)
+    let FmuLinearization { layout, structure, starts } = for_fmu(model);
+    describe(model, &guid(model, model_text), &layout, &structure, &starts)
 }
 
 /// The modelDescription.xml of the FMU of `model` with the GUID `guid` (see
 /// [`super::guid`]; `model` is the model as the FMU starts, start values applied), the
 /// linearization states `layout` and the dependencies `structure` (of the same selection,
 /// see [`for_fmu`]).
-pub fn describe(model: &Model, guid: &str, layout: &StateLayout, structure: &ModelStructure) -> String {
-    let vars = variables(model, layout);
+pub fn describe(
+    model: &Model,
+    guid: &str,
+    layout: &StateLayout,
+    structure: &ModelStructure,
+    starts: &StateValues,
+) -> String {
+    let vars = with_state_starts(variables(model, layout), model, layout, starts);
     let mut x = String::new();
     x.push_str("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
     x.push_str("<fmiModelDescription\n");
@@ -156,6 +162,26 @@ fn write_experiment(x: &mut String, model: &Model) {
     }
 }
 
+/// The states' start values: S, W (`der(S)` where it is W) from `starts` (the assembled
+/// model), X from the model's `start`. Other locals (derivatives, user variables) have none.
+fn with_state_starts(
+    mut vars: Vec<Variable>,
+    model: &Model,
+    layout: &StateLayout,
+    starts: &StateValues,
+) -> Vec<Variable> {
+    for v in &mut vars {
+        v.start = match v.target {
+            Target::State(k) => starts.s.get(k).copied(),
+            Target::StateDerivative(k) if layout.velocity_of_state(k).is_some() => starts.sd.get(k).copied(),
+            Target::Velocity(j) => starts.w.get(j).copied(),
+            Target::Diff(k) => Some(model.differentials[k].start.value),
+            _ => v.start,
+        };
+    }
+    vars
+}
+
 fn write_variable(x: &mut String, index: usize, v: &Variable) {
     let (causality, variability, initial) = match v.causality {
         // Solver settings may change between steps; model parameters only before
@@ -164,6 +190,12 @@ fn write_variable(x: &mut String, index: usize, v: &Variable) {
         Causality::Parameter => ("parameter", "fixed", Some("exact")),
         Causality::Input => ("input", "continuous", None),
         Causality::Output => ("output", "continuous", Some("calculated")),
+        // A state's start is its value in the assembled model (an iteration start: a value
+        // the host sets is met exactly); a differential state's is the model's, exact.
+        Causality::Local if v.start.is_some() && matches!(v.target, Target::Diff(_)) => {
+            ("local", "continuous", Some("exact"))
+        }
+        Causality::Local if v.start.is_some() => ("local", "continuous", Some("approx")),
         Causality::Local => ("local", "continuous", Some("calculated")),
     };
     let _ = writeln!(x, "    <!-- index {index} -->");
@@ -194,8 +226,8 @@ fn write_variable(x: &mut String, index: usize, v: &Variable) {
     if let Some(u) = &v.unit {
         let _ = write!(x, " unit=\"{}\"", escape(u));
     }
-    // Calculated variables (outputs, states) may not have a start value.
-    if let (Some(s), false) = (v.start, matches!(v.causality, Causality::Output | Causality::Local)) {
+    // Calculated variables (outputs, derivatives) may not have a start value.
+    if let (Some(s), false) = (v.start, matches!(v.causality, Causality::Output)) {
         let _ = write!(x, " start=\"{}\"", real(s));
     }
     x.push_str("/>\n    </ScalarVariable>\n");

@@ -179,9 +179,9 @@ fn contents(model_path: &Path, set: &[(String, f64)]) -> Result<Contents, PackEr
     let start_values = start_values_text(&overrides);
     let id = model_identifier(&model.name);
     let lib = library()?;
-    let FmuLinearization { layout, structure } = for_fmu(&model);
+    let FmuLinearization { layout, structure, starts } = for_fmu(&model);
     let guid = guid_with(&base, text, &start_values);
-    let xml = model_description::describe(&model, &guid, &layout, &structure);
+    let xml = model_description::describe(&model, &guid, &layout, &structure, &starts);
     let warnings = layout
         .missing
         .iter()

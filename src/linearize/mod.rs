@@ -53,23 +53,36 @@ pub struct FmuLinearization {
     pub layout: StateLayout,
     /// What each unknown depends on, in those states.
     pub structure: ModelStructure,
+    /// The states' values in the assembled model at its start (the FMU's start values;
+    /// empty without states).
+    pub starts: StateValues,
 }
 
 /// The linearization states of `model`'s FMU ([`selection_at_start`], one engine run) and
 /// the structure of its linearization in them.
 pub fn for_fmu(model: &Model) -> FmuLinearization {
-    match selection_at_start(model) {
-        Ok(sel) => FmuLinearization { layout: StateLayout::of(&sel), structure: ModelStructure::of(model, Some(&sel)) },
+    let t0 = model.experiment.start.unwrap_or(0.0);
+    let run = || -> Result<(Selection, StateValues), EngineError> {
+        let mut sim = Simulator::new(model, tolerances::selection_options(), t0)?;
+        let sel = select_states(sim.system(), sim.q(), t0, &sim.inputs()).map_err(EngineError::Numeric)?;
+        let starts = state_values(&mut sim, &sel)?;
+        Ok((sel, starts))
+    };
+    match run() {
+        Ok((sel, starts)) => {
+            FmuLinearization { layout: StateLayout::of(&sel), structure: ModelStructure::of(model, Some(&sel)), starts }
+        }
         Err(e) => FmuLinearization {
             layout: StateLayout::unavailable(e.to_string()),
             structure: ModelStructure::of(model, None),
+            starts: StateValues::default(),
         },
     }
 }
 
 /// Values at the current point of the position states S, their rates Ṡ, the velocity
 /// states W and their rates Ẇ.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct StateValues {
     /// S.
     pub s: Vec<f64>,

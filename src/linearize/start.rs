@@ -22,10 +22,17 @@ pub enum StateTarget {
 
 /// The start values `set` (name, state, value) as conditions on `sys` (a system built
 /// from the model the layout was selected on).
-pub fn start_values(sys: &System, layout: &StateLayout, set: &[(String, StateTarget, f64)]) -> Result<StartValues, String> {
+pub fn start_values(
+    sys: &System,
+    layout: &StateLayout,
+    set: &[(String, StateTarget, f64)],
+) -> Result<StartValues, String> {
     let mut out = StartValues::default();
     if set.iter().all(|(_, t, _)| matches!(t, StateTarget::Differential(_))) {
-        out.differentials = set.iter().filter_map(|(_, t, v)| if let StateTarget::Differential(k) = t { Some((*k, *v)) } else { None }).collect();
+        out.differentials = set
+            .iter()
+            .filter_map(|(_, t, v)| if let StateTarget::Differential(k) = t { Some((*k, *v)) } else { None })
+            .collect();
         return Ok(out);
     }
     let sel = selection_by_name(sys, layout)?;

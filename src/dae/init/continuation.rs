@@ -18,8 +18,8 @@ use crate::mechanics::constraints::{ConstraintEl, ConstraintKind};
 use crate::mechanics::coords::gather;
 use crate::mechanics::forces::ForceKind;
 use crate::mechanics::local::LocalCtx;
-use crate::model::SpringType;
 use crate::mechanics::measures::StateKind;
+use crate::model::SpringType;
 use crate::model::expr::{Expr, ExprEnv, KinFn};
 use crate::model::units;
 
@@ -56,7 +56,10 @@ pub(super) struct Drive {
 
 /// Whether element `el` is a drive (its value is set by the model, not by the drawing).
 pub(super) fn is_drive(el: &ConstraintEl) -> bool {
-    matches!(el.kind, ConstraintKind::Rotation { .. } | ConstraintKind::Translation { .. } | ConstraintKind::State { .. })
+    matches!(
+        el.kind,
+        ConstraintKind::Rotation { .. } | ConstraintKind::Translation { .. } | ConstraintKind::State { .. }
+    )
 }
 
 /// The drives among `els`, measured at q (the drawn pose made consistent with the joints).
