@@ -190,8 +190,7 @@ impl Instance {
             let var = self.var(vr)?;
             set.push((var.name.clone(), self.state_target(var)?, v));
         }
-        let sys = crate::mechanics::System::from_model(model)?;
-        start_values(&sys, &self.layout, &set)
+        start_values(model, &self.layout, &set)
     }
 
     /// The state a start value on `var` sets (Err: it is not a settable state).

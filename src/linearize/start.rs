@@ -8,6 +8,7 @@ use super::states::VelState;
 use crate::dae::{StartValue, StartValues};
 use crate::mechanics::System;
 use crate::mechanics::constraints::VelocityIcKind;
+use crate::model::Model;
 
 /// A state of the layout that a start value sets.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -20,10 +21,10 @@ pub enum StateTarget {
     Differential(usize),
 }
 
-/// The start values `set` (name, state, value) as conditions on `sys` (a system built
-/// from the model the layout was selected on).
+/// The start values `set` (name, state, value) as conditions on the system of `model`
+/// (whose states `layout` lists).
 pub fn start_values(
-    sys: &System,
+    model: &Model,
     layout: &StateLayout,
     set: &[(String, StateTarget, f64)],
 ) -> Result<StartValues, String> {
@@ -35,7 +36,9 @@ pub fn start_values(
             .collect();
         return Ok(out);
     }
-    let sel = selection_by_name(sys, layout)?;
+    // A system built as the simulator builds its own (same frames, same angle slots).
+    let sys = System::from_model(model)?;
+    let sel = selection_by_name(&sys, layout)?;
     for (name, target, value) in set {
         match *target {
             StateTarget::Position(k) => {
