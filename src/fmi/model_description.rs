@@ -190,11 +190,9 @@ fn write_variable(x: &mut String, index: usize, v: &Variable) {
         Causality::Parameter => ("parameter", "fixed", Some("exact")),
         Causality::Input => ("input", "continuous", None),
         Causality::Output => ("output", "continuous", Some("calculated")),
-        // A state's start is its value in the assembled model (an iteration start: a value
-        // the host sets is met exactly); a differential state's is the model's, exact.
-        Causality::Local if v.start.is_some() && matches!(v.target, Target::Diff(_)) => {
-            ("local", "continuous", Some("exact"))
-        }
+        // A state's start is its value in the assembled model (X: the model's start), an
+        // iteration start in FMI terms: a value the host sets is met exactly. (As `approx`
+        // every state stays an InitialUnknown.)
         Causality::Local if v.start.is_some() => ("local", "continuous", Some("approx")),
         Causality::Local => ("local", "continuous", Some("calculated")),
     };
