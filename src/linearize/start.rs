@@ -29,20 +29,16 @@ pub fn start_values(
     set: &[(String, StateTarget, f64)],
 ) -> Result<StartValues, String> {
     let mut out = StartValues::default();
-    if set.iter().all(|(_, t, _)| matches!(t, StateTarget::Differential(_))) {
-        out.differentials = set
-            .iter()
-            .filter_map(|(_, t, v)| if let StateTarget::Differential(k) = t { Some((*k, *v)) } else { None })
-            .collect();
-        return Ok(out);
-    }
-    // A system built as the simulator builds its own (same frames, same angle slots).
-    let sys = System::from_model(model)?;
-    let sel = selection_by_name(&sys, layout)?;
+    // The states' measures, resolved only when a position or velocity state is set (a
+    // model without linearization states has differential states only): on a system built
+    // as the simulator builds its own (same frames, same angle slots).
+    let needs_measures = set.iter().any(|(_, t, _)| !matches!(t, StateTarget::Differential(_)));
+    let sel = if needs_measures { Some(selection_by_name(&System::from_model(model)?, layout)?) } else { None };
+    let selection = || sel.as_ref().expect("resolved when a position or velocity state is set");
     for (name, target, value) in set {
         match *target {
             StateTarget::Position(k) => {
-                let s = &sel.states[k];
+                let s = &selection().states[k];
                 out.positions.push(StartValue {
                     name: name.clone(),
                     kind: s.kind.clone(),
@@ -51,7 +47,7 @@ pub fn start_values(
                 });
             }
             StateTarget::Velocity(j) => {
-                let (kind, bodies) = match &sel.velocities[j] {
+                let (kind, bodies) = match &selection().velocities[j] {
                     VelState::Derivative(s) => (VelocityIcKind::Rate(s.kind.clone()), s.bodies.clone()),
                     VelState::User(u) => (VelocityIcKind::User { f: u.f.clone(), abase: u.abase }, u.bodies.clone()),
                 };

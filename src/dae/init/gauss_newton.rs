@@ -22,18 +22,18 @@ pub(super) enum Failure {
 /// found redundant (rows beyond `sys.m`, exact initial conditions, never are) are the
 /// ones the Newton corrections use (a redundant row is met when the others are, or the
 /// constraints conflict).
-pub(super) struct ActiveRows {
+struct ActiveRows {
     /// Number of rows (the largest row + 1 of the set).
-    pub count: usize,
+    count: usize,
     /// Per row: covered by the set.
-    pub covered: Vec<bool>,
+    covered: Vec<bool>,
     /// Per row: covered and not redundant.
-    pub active: Vec<bool>,
+    active: Vec<bool>,
 }
 
 impl ActiveRows {
     /// The enforced rows of `els`.
-    pub fn of(sys: &System, els: &[ConstraintEl]) -> ActiveRows {
+    fn of(sys: &System, els: &[ConstraintEl]) -> ActiveRows {
         let count = els.iter().map(|e| e.row + e.neq).max().unwrap_or(0);
         let (mut covered, mut active) = (vec![false; count], vec![false; count]);
         for e in els {
@@ -46,7 +46,7 @@ impl ActiveRows {
     }
 
     /// The covered row of the largest |C| and that value.
-    pub fn worst(&self, c: &[f64]) -> (usize, f64) {
+    fn worst(&self, c: &[f64]) -> (usize, f64) {
         let mut w = (0, 0.0f64);
         for (r, v) in c.iter().enumerate().filter(|(r, _)| self.covered[*r]) {
             if !v.is_finite() {

@@ -35,27 +35,21 @@ fn check(ctx: &LocalCtx<f64>, kind: &ConstraintKind) -> Option<String> {
     match kind {
         ConstraintKind::Joint { kind, i, j } => {
             let (a, b) = (ctx.pose(*i).r, ctx.pose(*j).r);
-            let zz = a.col(2).dot(&b.col(2));
-            let xx = a.col(0).dot(&b.col(0));
-            let axes_fixed = matches!(kind, JointType::Fixed | JointType::Translational);
-            match kind {
-                JointType::Revolute
-                | JointType::Cylindrical
-                | JointType::Planar
-                | JointType::Fixed
-                | JointType::Translational
-                    if zz <= 0.0 =>
-                {
-                    Some(format!(
-                        "its markers' z axes point opposite ways (z_i·z_j = {zz:.3}): the joint would be \
-                         put together inside out"
-                    ))
-                }
-                _ if axes_fixed && xx <= 0.0 => Some(format!(
+            let (zz, xx) = (a.col(2).dot(&b.col(2)), a.col(0).dot(&b.col(0)));
+            let z_parallel = !matches!(kind, JointType::Universal | JointType::Spherical);
+            let x_parallel = matches!(kind, JointType::Fixed | JointType::Translational);
+            if z_parallel && zz <= 0.0 {
+                Some(format!(
+                    "its markers' z axes point opposite ways (z_i·z_j = {zz:.3}): the joint would be put \
+                     together inside out"
+                ))
+            } else if x_parallel && xx <= 0.0 {
+                Some(format!(
                     "its markers' x axes point opposite ways (x_i·x_j = {xx:.3}): the joint would be put \
                      together turned by half a turn about z"
-                )),
-                _ => None,
+                ))
+            } else {
+                None
             }
         }
         ConstraintKind::Rotation { i, j, f: Expr::Num(f), .. } => {

@@ -8,7 +8,7 @@
 //!    put together inside out is an error naming it, never a silent start.
 
 use super::continuation::{self, Drive};
-use super::gauss_newton::{self, ActiveRows, Failure};
+use super::gauss_newton::{self, Failure};
 use super::orientation;
 use crate::dae::sparse::SparseLu;
 use crate::mechanics::System;
@@ -67,7 +67,8 @@ pub fn assemble_positions(
     let zeros = vec![0.0; sys.n()];
     // 1. The drawing made consistent; drives left free.
     let free: Vec<ConstraintEl> = els.iter().filter(|e| !continuation::is_drive(e)).cloned().collect();
-    let drawing_unmet = unmet_list(sys, &free, q, t, inputs, limit);
+    let drawing_unmet =
+        unmet_list(sys, &free, q, t, inputs, limit).into_iter().map(|(e, r)| (e.tag, e.name.clone(), r)).collect();
     let mut lu = SparseLu::new();
     gauss_newton::solve(sys, &free, q, t, inputs, limit, MAX_ITERATIONS, &mut lu)
         .map_err(|f| failure(sys, &free, q, t, inputs, limit, f))?;
@@ -164,27 +165,23 @@ fn stalled(
     )
 }
 
-/// The elements of `els` not met at q (some |C_i| above `limit`): (tag, name, largest
-/// |C|), worst first.
-fn unmet_list(
+/// The elements of `els` not met at q (some |C_i| above `limit`) with their largest |C|,
+/// worst first.
+fn unmet_list<'a>(
     sys: &System,
-    els: &[ConstraintEl],
+    els: &'a [ConstraintEl],
     q: &[f64],
     t: f64,
     inputs: &[f64],
     limit: f64,
-) -> Vec<(&'static str, String, f64)> {
+) -> Vec<(&'a ConstraintEl, f64)> {
     let c = constraint_rows(sys, els, q, t, inputs).c;
-    let rows = ActiveRows::of(sys, els);
-    let mut bad: Vec<(&'static str, String, f64)> = els
+    let mut bad: Vec<(&ConstraintEl, f64)> = els
         .iter()
-        .map(|e| {
-            let r = (e.row..e.row + e.neq).filter(|&r| rows.covered[r]).fold(0.0f64, |a, r| a.max(c[r].abs()));
-            (e.tag, e.name.clone(), r)
-        })
-        .filter(|(_, _, r)| *r > limit || !r.is_finite())
+        .map(|e| (e, c[e.row..e.row + e.neq].iter().fold(0.0f64, |a, v| a.max(v.abs()))))
+        .filter(|(_, r)| *r > limit || !r.is_finite())
         .collect();
-    bad.sort_by(|a, b| b.2.total_cmp(&a.2));
+    bad.sort_by(|a, b| b.1.total_cmp(&a.1));
     bad
 }
 
@@ -198,8 +195,7 @@ fn unmet(sys: &System, els: &[ConstraintEl], q: &[f64], t: f64, inputs: &[f64], 
     let ctx = LocalCtx::new(sys, &ids, &sys.q_init, &zeros, &zeros, t, inputs);
     unmet_list(sys, els, q, t, inputs, limit)
         .iter()
-        .map(|(tag, name, r)| {
-            let e = els.iter().find(|e| e.name == *name && e.tag == *tag).expect("listed from els");
+        .map(|(e, r)| {
             let markers = match &e.kind {
                 ConstraintKind::Joint { i, j, .. }
                 | ConstraintKind::Rotation { i, j, .. }
@@ -210,7 +206,7 @@ fn unmet(sys: &System, els: &[ConstraintEl], q: &[f64], t: f64, inputs: &[f64], 
                 .map(|(i, j)| ctx.eval_expr(&Expr::Kin(KinFn::Dm, i, Some(j), None), 0))
                 .filter(|d: &f64| d.is_finite())
                 .map_or(String::new(), |d| format!(", markers {d:.3e} m apart as written"));
-            format!("{tag} '{name}' (residual {r:.3e}{gap})")
+            format!("{} '{}' (residual {r:.3e}{gap})", e.tag, e.name)
         })
         .collect::<Vec<_>>()
         .join(", ")
