@@ -44,9 +44,10 @@ def cli() -> Path:
 def pack(model, out=None, out_dir=None, start_values=None) -> Path:
     """Pack `model` (an mbfmu model file) into the FMU `out` (default: the model's name
     with .fmu beside it); `out_dir` also writes the unzipped FMU there. Returns `out`.
-    `start_values` (a dict parameter name -> float) replaces the file's values as the FMU's
-    start values (`mbfmu pack --set name=value`: every attribute using them re-evaluated;
-    the modelDescription's `start` and an instance's defaults). A model error, an unknown
+    `start_values` (a dict parameter or state name -> float) replaces the file's values as
+    the FMU's start values (`mbfmu pack --set name=value`: a parameter's every use
+    re-evaluated, a state such as `hinge.angle` met exactly at initialization; the
+    modelDescription's `start` and an instance's defaults). A model error, an unknown
     name (with a "did you mean" when one is close) or a value the model rejects is raised
     as ArgumentError with the tool's message; what the packed FMU lacks (the tool's
     warnings) is issued as a PackWarning."""

@@ -71,3 +71,19 @@ def test_unknown_names_and_bad_values_are_argument_errors(tmp_path):
     with pytest.raises(mbfmu.ArgumentError, match=r"not a number"):
         mbfmu.pack(model, tmp_path / "d.fmu", start_values={"L": "two"})
     assert not any(tmp_path.iterdir())
+
+
+def test_start_values_on_states_start_the_fmu_there(tmp_path):
+    # The pendulum started at θ = 1 rad, ω = -0.5 rad/s by start values on its states:
+    # the FMU, told nothing, starts there, with the analytic energy
+    # E = ½ (Jc + m L²) ω² − m g L cos θ (m = 1, L = 0.5, Jc = 0.1), conserved.
+    fmu = mbfmu.pack(
+        MODELS / "pendulum.xml", tmp_path / "s.fmu", start_values={"hinge.angle": 1.0, "der(hinge.angle)": -0.5}
+    )
+    got = _simulate(fmu)
+    assert got[0, 1] == pytest.approx(1.0, abs=1e-12)
+    assert got[0, 2] == pytest.approx(-0.5, abs=1e-12)
+    e0 = 0.5 * (0.1 + 0.25) * 0.25 - G * 0.5 * math.cos(1.0)
+    assert got[:, 5] == pytest.approx(e0, abs=1e-6)
+    with pytest.raises(mbfmu.ArgumentError, match=r"did you mean 'hinge.angle'\?"):
+        mbfmu.pack(MODELS / "pendulum.xml", tmp_path / "t.fmu", start_values={"hinge.angel": 1.0})

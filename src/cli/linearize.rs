@@ -47,7 +47,7 @@ pub struct LinearizeArgs {
     /// rows, as fmpy's input arrays).
     #[arg(long, value_name = "FILE")]
     pub input: Option<PathBuf>,
-    /// Parameter values to use instead of the file's.
+    /// Parameter values and state start values to use instead of the file's.
     #[command(flatten)]
     pub set: SetArgs,
     /// Threads for the right-hand sides of the augmented system.

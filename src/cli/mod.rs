@@ -44,7 +44,7 @@ pub enum Command {
     Check {
         /// Model file (XML, see MODEL_FORMAT.md).
         model: PathBuf,
-        /// Parameter values to use instead of the file's.
+        /// Parameter values and state start values to use instead of the file's.
         #[command(flatten)]
         set: SetArgs,
     },
@@ -102,13 +102,15 @@ pub fn main() -> ExitCode {
     }
 }
 
-/// `--set NAME=VALUE` (repeatable): start values instead of the model file's (today: model
-/// parameters), shared by `check`, `simulate`, `linearize` and `pack`. Parsed and resolved
+/// `--set NAME=VALUE` (repeatable): start values instead of the model file's (parameters
+/// and states), shared by `check`, `simulate`, `linearize` and `pack`. Parsed and resolved
 /// by [`crate::model::overrides`], so that every command reads them alike.
 #[derive(Clone, Debug, Default, Args)]
 pub struct SetArgs {
     /// Use VALUE for the parameter NAME (repeatable): every attribute using it is
-    /// re-evaluated, as when an FMU's parameter is set before initialization.
+    /// re-evaluated, as when an FMU's parameter is set before initialization; or start
+    /// the state NAME (`hinge.angle`, `der(hinge.angle)`, `arm.x`, a differential) at VALUE,
+    /// met exactly by initialization.
     #[arg(long = "set", value_name = "NAME=VALUE")]
     pub set: Vec<String>,
 }
@@ -132,7 +134,9 @@ impl SetArgs {
         }
         let usage = |e: String| CliError::Usage(format!("--set: {e}"));
         let overrides = model.resolve_overrides(&pairs).map_err(usage)?;
-        model.with_overrides(&overrides).map_err(usage)
+        let model = model.with_overrides(&overrides).map_err(usage)?;
+        crate::dae::StartValues::check_names(&model).map_err(usage)?;
+        Ok(model)
     }
 }
 

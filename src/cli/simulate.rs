@@ -48,7 +48,7 @@ pub struct SimulateArgs {
     /// rows, as fmpy's input arrays).
     #[arg(long, value_name = "FILE")]
     pub input: Option<PathBuf>,
-    /// Parameter values to use instead of the file's.
+    /// Parameter values and state start values to use instead of the file's.
     #[command(flatten)]
     pub set: SetArgs,
 }

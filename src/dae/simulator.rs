@@ -37,6 +37,8 @@ impl Simulator {
     /// set that cannot be met is an error naming the values.
     pub fn with_start(model: &Model, opts: SimOptions, t0: f64, start: &StartValues) -> Result<Simulator, EngineError> {
         let mut sys = System::from_model(model).map_err(EngineError::Numeric)?;
+        // Values set by name in the model (`--set`, a packed FMU's), then the caller's.
+        let start = StartValues::named(&sys, model).map_err(EngineError::Numeric)?.overridden_by(start);
         start.apply(&mut sys);
         let inputs: Vec<f64> = model.inputs.iter().map(|i| i.start.value).collect();
         let lay = Layout::of(&sys);

@@ -162,8 +162,8 @@ fn write_experiment(x: &mut String, model: &Model) {
     }
 }
 
-/// The states' start values: S, W (`der(S)` where it is W) from `starts` (the assembled
-/// model), X from the model's `start`. Other locals (derivatives, user variables) have none.
+/// The states' start values: those set when packing as set, others S, W (`der(S)` where
+/// it is W) from `starts` (the assembled model), X from the model's `start`. Other locals (derivatives, user variables) have none.
 fn with_state_starts(
     mut vars: Vec<Variable>,
     model: &Model,
@@ -171,6 +171,11 @@ fn with_state_starts(
     starts: &StateValues,
 ) -> Vec<Variable> {
     for v in &mut vars {
+        // A state given a start value when packing (`--set`) has exactly that start.
+        if let Some((_, x)) = model.state_starts.iter().find(|(n, _)| *n == v.name) {
+            v.start = Some(*x);
+            continue;
+        }
         v.start = match v.target {
             Target::State(k) => starts.s.get(k).copied(),
             Target::StateDerivative(k) if layout.velocity_of_state(k).is_some() => starts.sd.get(k).copied(),

@@ -33,6 +33,7 @@ use zip::write::SimpleFileOptions;
 
 use super::guid::{guid, guid_with, model_identifier};
 use super::model_description;
+use crate::dae::StartValues;
 use crate::linearize::{FmuLinearization, StateLayout, for_fmu};
 use crate::model::overrides::{parse_start_values, start_values_text};
 use crate::model::{Model, ModelError, load_str};
@@ -176,6 +177,7 @@ fn contents(model_path: &Path, set: &[(String, f64)]) -> Result<Contents, PackEr
     let base = load_str(text, &label)?;
     let overrides = base.resolve_overrides(set).map_err(PackError::StartValue)?;
     let model = base.with_overrides(&overrides).map_err(PackError::StartValue)?;
+    StartValues::check_names(&model).map_err(PackError::StartValue)?;
     let start_values = start_values_text(&overrides);
     let id = model_identifier(&model.name);
     let lib = library()?;
@@ -275,6 +277,7 @@ pub fn read_start_values(resources: &Path, base: Model, model_text: &str) -> Res
     let overrides = base.resolve_overrides(&pairs).map_err(bad)?;
     let own = guid_with(&base, model_text, &start_values_text(&overrides));
     let model = base.with_overrides(&overrides).map_err(bad)?;
+    StartValues::check_names(&model).map_err(bad)?;
     Ok((model, own))
 }
 

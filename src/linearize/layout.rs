@@ -5,8 +5,9 @@
 //! an instance's engine ([`selection_by_name`]).
 
 use super::select::Selection;
-use super::states::{StateFn, VelState, internal_state, joint_states, user_states};
+use super::states::{StateFn, VelState};
 use crate::mechanics::System;
+use crate::mechanics::measure_names::measure_by_name;
 use crate::model::Model;
 
 /// One linearization state as the FMU names it.
@@ -161,26 +162,8 @@ fn unescape(s: &str) -> Option<String> {
 /// `body.x|y|z|psi|theta|phi` (the angles relative to the body's reference frame), or a
 /// flexible body's modal coordinate `body.etaK`.
 fn position_by_name(sys: &System, name: &str) -> Result<StateFn, String> {
-    if let Some(s) = user_states(sys).into_iter().chain(joint_states(sys)).find(|u| u.name == name) {
-        return Ok(s);
-    }
-    let coord = ["x", "y", "z", "psi", "theta", "phi"];
-    let unknown = || format!("unknown linearization state '{name}'");
-    let (body, c) = name.rsplit_once('.').ok_or_else(unknown)?;
-    let b = sys.bodies.iter().position(|x| x.name == body);
-    // A flexible body's modal coordinate `body.etaK` (K from 1).
-    if let (Some(b), Some(k)) = (b, c.strip_prefix("eta").and_then(|k| k.parse::<usize>().ok())) {
-        let m = sys.modal_range(b);
-        return match k {
-            1.. if k <= m.len() => Ok(internal_state(sys, m.start + k - 1)),
-            _ => Err(unknown()),
-        };
-    }
-    let k = coord.iter().position(|x| *x == c);
-    match (b, k) {
-        (Some(b), Some(k)) => Ok(internal_state(sys, 6 * b + k)),
-        _ => Err(unknown()),
-    }
+    let (kind, bodies) = measure_by_name(sys, name).ok_or_else(|| format!("unknown linearization state '{name}'"))?;
+    Ok(StateFn { name: name.to_string(), kind, bodies })
 }
 
 /// The selection `layout` names, rebuilt on `sys`: position states by name ([`StateLayout`]

@@ -7,19 +7,10 @@ use super::jets::{PositionFn, jets};
 use crate::ad::Real;
 use crate::mechanics::System;
 use crate::mechanics::local::LocalCtx;
+use crate::mechanics::measure_names::{BODY_COORDS, expr_bodies};
+pub use crate::mechanics::measure_names::{derivative_name, derivative_of_name};
 pub use crate::mechanics::measures::StateKind;
-use crate::model::expr::{Expr, deps};
-
-/// The name of the time derivative of the quantity named `name`: `der(name)`, the FMI
-/// convention; the one place that writes it ([`derivative_of_name`] reads it).
-pub fn derivative_name(name: &str) -> String {
-    format!("der({name})")
-}
-
-/// The `name` of [`derivative_name`]`(name)`, if `der` is one.
-pub fn derivative_of_name(der: &str) -> Option<&str> {
-    der.strip_prefix("der(")?.strip_suffix(')')
-}
+use crate::model::expr::Expr;
 
 /// A velocity-level state W (seed Eq. 34h): the time derivative of a position-level
 /// candidate, or a user `<velocity>` expression w(q, u, t).
@@ -102,14 +93,6 @@ impl VelState {
     }
 }
 
-/// The bodies (sorted, once each) whose markers expression `f` reads.
-fn expr_bodies(sys: &System, f: &Expr) -> Vec<usize> {
-    let mut bodies: Vec<usize> = deps(f).markers.iter().filter_map(|&m| sys.markers[m].body).collect();
-    bodies.sort_unstable();
-    bodies.dedup();
-    bodies
-}
-
 /// The user's `<velocity>` candidates of the model.
 pub fn user_velocities(sys: &System) -> Vec<UserVelocity> {
     sys.lin_velocities
@@ -177,9 +160,8 @@ pub fn internal_state(sys: &System, i: usize) -> StateFn {
         return StateFn { name, kind: StateKind::Modal { k }, bodies: vec![f.body] };
     }
     let (b, k) = (i / 6, i % 6);
-    let names = ["x", "y", "z", "psi", "theta", "phi"];
     let kind = if k < 3 { StateKind::Position { k } } else { StateKind::Angle { k: k - 3, r0: sys.r0[b] } };
-    StateFn { name: format!("{}.{}", sys.bodies[b].name, names[k]), kind, bodies: vec![b] }
+    StateFn { name: format!("{}.{}", sys.bodies[b].name, BODY_COORDS[k]), kind, bodies: vec![b] }
 }
 
 impl StateFn {

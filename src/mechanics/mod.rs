@@ -15,6 +15,7 @@
 //! - [`system`]: the [`System`] struct: elements, row and slot layout, per-simulation state.
 //! - [`external`]: layout of the external values [inputs; Z; L] ([`external::ExtLayout`]).
 //! - [`from_model`]: [`System::from_model`], step by step.
+//! - [`measure_names`]: state names (`hinge.angle`, `arm.x`, `arm.eta2`) and the measures they name.
 //! - [`local`]: the element context [`local::LocalCtx`] that element equations read.
 //! - [`measure_values`]: the value of a measure in an element context.
 //! - [`nonholonomic_equations`]: equations g of the non-holonomic elements, wheel contact.
@@ -50,6 +51,7 @@ pub mod load_components;
 pub mod loads;
 pub mod local;
 pub mod mass;
+pub mod measure_names;
 pub mod measure_values;
 pub mod measures;
 pub mod nonholonomic;

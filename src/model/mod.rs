@@ -74,4 +74,8 @@ pub struct Model {
     pub experiment: Experiment,
     /// `<analysis static="true"/>`.
     pub static_analysis: bool,
+    /// Start values set on states by name (`--set hinge.angle=0.3`, a packed FMU's start
+    /// values), met exactly by initialization; resolved against the mechanism by the engine
+    /// (`dae::StartValues::named`). Empty as read from a file.
+    pub state_starts: Vec<(String, f64)>,
 }

@@ -3,12 +3,12 @@
 //! the model with the values applied. One place for every user of overrides, so that the
 //! CLI commands and the FMU agree on what a name means and on every error message.
 //!
-//! Today a name resolves to a model parameter ([`OverrideTarget::Parameter`]), applied
-//! with the re-evaluation the FMU does when a parameter is set before initialization
-//! ([`Model::with_params`]). State start values (the FMU's states such as `hinge.angle`
-//! or `der(hinge.angle)`) are to be added later as further [`OverrideTarget`] variants:
-//! [`Model::resolve_overrides`] is where their names get resolved, and
-//! [`Model::with_overrides`] where they get applied.
+//! A name resolves to a model parameter ([`OverrideTarget::Parameter`]), applied with the
+//! re-evaluation the FMU does when a parameter is set before initialization
+//! ([`Model::with_params`]), or else to a state ([`OverrideTarget::State`]: `hinge.angle`,
+//! `der(hinge.angle)`, `body.x`, a `<linearization>` state, a differential), kept by name
+//! in [`Model::state_starts`]: only the mechanism knows its states, so the engine resolves
+//! those names (`dae::StartValues::named`, which also reports an unknown one).
 
 use crate::model::Model;
 
@@ -17,7 +17,8 @@ use crate::model::Model;
 pub enum OverrideTarget {
     /// Index into [`Model::parameters`]: the parameter's value.
     Parameter(usize),
-    // Later: the start values of the FMU's states (`hinge.angle`, `der(hinge.angle)`).
+    /// A state's start value (the override's name is the state's).
+    State,
 }
 
 /// One resolved override: the name as given, what it sets, and the value.
@@ -98,8 +99,8 @@ pub fn parse_start_values(text: &str) -> Result<Vec<(String, f64)>, String> {
 }
 
 impl Model {
-    /// What the name `name` may set: a parameter. An unknown name is an error naming it,
-    /// with the closest parameter name as a suggestion.
+    /// What the name `name` may set: a parameter, else a state (resolved by the engine).
+    /// An input is an error.
     pub fn override_target(&self, name: &str) -> Result<OverrideTarget, String> {
         if let Some(k) = self.parameters.iter().position(|p| p.name == name) {
             return Ok(OverrideTarget::Parameter(k));
@@ -107,9 +108,16 @@ impl Model {
         if self.inputs.iter().any(|i| i.name == name) {
             return Err(format!("'{name}' is an input, not a parameter (inputs are given with --input)"));
         }
-        let hint = did_you_mean(name, self.parameters.iter().map(|p| p.name.as_str()));
+        Ok(OverrideTarget::State)
+    }
+
+    /// The error for a name that is neither a parameter nor one of the states `states`,
+    /// with the closest of all those names as a suggestion.
+    pub fn unknown_override(&self, name: &str, states: &[String]) -> String {
+        let params = self.parameters.iter().map(|p| p.name.as_str());
+        let hint = did_you_mean(name, params.chain(states.iter().map(String::as_str)));
         let known = if self.parameters.is_empty() { " (the model has no parameters)" } else { "" };
-        Err(format!("model '{}' has no parameter '{name}'{known}{hint}", self.name))
+        format!("model '{}' has no parameter '{name}'{known}{hint} (nor a state of that name)", self.name)
     }
 
     /// Resolve `NAME=VALUE` pairs: every name known ([`Model::override_target`]), no
@@ -122,13 +130,15 @@ impl Model {
             if !value.is_finite() {
                 return Err(format!("{name}={value}: the value must be finite"));
             }
-            if out.iter().any(|o| o.target == target) {
+            if out.iter().any(|o| o.target == target && (target != OverrideTarget::State || o.name == *name)) {
                 return Err(format!("'{name}' is set twice"));
             }
             out.push(Override { name: name.clone(), target, value: *value });
         }
+        // Parameters in file order, then states in the order given (a stable sort).
         out.sort_by_key(|o| match o.target {
             OverrideTarget::Parameter(k) => k,
+            OverrideTarget::State => usize::MAX,
         });
         Ok(out)
     }
@@ -136,18 +146,24 @@ impl Model {
     /// A copy with the overrides applied: parameters set and every attribute that uses
     /// them re-evaluated and re-validated, as when an FMU's parameter is set before
     /// initialization ([`Model::with_params`]; a parameter whose value is an expression of
-    /// others is a parameter of its own and keeps its value). No overrides: a plain copy.
+    /// others is a parameter of its own and keeps its value); state start values added to
+    /// [`Model::state_starts`]. No overrides: a plain copy.
     pub fn with_overrides(&self, overrides: &[Override]) -> Result<Model, String> {
-        if overrides.is_empty() {
-            return Ok(self.clone());
-        }
         let mut p = self.param_values();
+        let mut states = Vec::new();
         for o in overrides {
             match o.target {
                 OverrideTarget::Parameter(k) => p[k] = o.value,
+                OverrideTarget::State => states.push((o.name.clone(), o.value)),
             }
         }
-        self.with_params(&p)
+        let mut m = if overrides.iter().any(|o| o.target != OverrideTarget::State) {
+            self.with_params(&p)?
+        } else {
+            self.clone()
+        };
+        m.state_starts.extend(states);
+        Ok(m)
     }
 }
 
@@ -209,7 +225,9 @@ mod tests {
     #[test]
     fn bad_overrides_are_errors_naming_the_problem() {
         let m = model();
-        let e = m.resolve_overrides(&[("lenght".into(), 1.0)]).unwrap_err();
+        let o = m.resolve_overrides(&[("lenght".into(), 1.0)]).unwrap();
+        assert_eq!(o[0].target, OverrideTarget::State);
+        let e = m.unknown_override("lenght", &["b.x".into()]);
         assert!(e.contains("no parameter 'lenght'; did you mean 'length'?"), "{e}");
         let e = m.resolve_overrides(&[("mass".into(), 1.0), ("mass".into(), 2.0)]).unwrap_err();
         assert!(e.contains("'mass' is set twice"), "{e}");

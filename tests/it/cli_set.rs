@@ -255,3 +255,74 @@ fn pack_set_makes_the_values_the_fmus_start_values() {
         assert!(msgs.contains("start_values.txt") && msgs.contains(what), "{bad}: {msgs}");
     }
 }
+
+#[test]
+fn set_on_states_starts_there_as_the_exact_joint_ics_of_an_edited_file_do() {
+    // `--set hinge.angle=1 --set der(hinge.angle)=-0.5` against the same start written as
+    // exact joint ICs in the file (ic_angle, ic_angular_speed: another path through
+    // assembly), and against the analytic energy E = ½ (Jc + m L²) ω² − m g L cos θ.
+    let dir = scratch("states");
+    let copy = dir.join("pendulum_ics.xml");
+    let text = model_text("pendulum.xml").replace(
+        r#"<joint name="hinge" type="revolute" i="bob.P" j="ground.O"/>"#,
+        r#"<joint name="hinge" type="revolute" i="bob.P" j="ground.O" ic_angle="1" ic_angular_speed="-0.5"/>"#,
+    );
+    std::fs::write(&copy, text).unwrap();
+    let common = ["--end", "0.5", "--step", "0.1", "--tol", "1e-10"];
+    let run = |model: &str, extra: &[&str]| {
+        let mut args = vec!["simulate", model];
+        args.extend(common);
+        args.extend(extra);
+        csv_numbers(&mbfmu(&args))
+    };
+    let set = run(PENDULUM, &["--set", "hinge.angle=1", "--set", "der(hinge.angle)=-0.5"]);
+    let ics = run(&arg(&copy), &[]);
+    let (angle, omega, energy) = (1, 2, 5); // time, angle, omega, x, z, energy
+    assert_eq!((set[0][angle], set[0][omega]), (1.0, -0.5), "{:?}", set[0]);
+    let mut worst = 0.0f64;
+    for (a, b) in set.iter().zip(&ics) {
+        for (x, y) in a.iter().zip(b) {
+            worst = worst.max((x - y).abs());
+        }
+    }
+    // The same initial state to round-off, integrated at tolerance 1e-10 over 0.5 s.
+    assert!(worst <= 1e-9, "--set on states and the file's exact ICs differ by {worst}");
+    let e0 = 0.5 * (0.1 + 0.25) * 0.25 - G * 0.5 * 1f64.cos();
+    for row in &set {
+        assert!((row[energy] - e0).abs() < 1e-6, "{} vs {e0}", row[energy]);
+    }
+    // An unknown state is bad input, with the closest name.
+    let o = mbfmu(&["simulate", PENDULUM, "--set", "hinge.angel=1"]);
+    assert_bad_input(&o, "did you mean 'hinge.angle'?");
+}
+
+#[test]
+fn pack_set_on_a_state_is_the_fmus_start_and_a_host_value_replaces_it() {
+    let (dir, xml) = pack_dir(&scratch("pack-state"), &["hinge.angle=0.3"]);
+    assert_eq!(start_of(&xml, "hinge.angle"), "0.3");
+    assert_eq!(std::fs::read_to_string(dir.join("resources/start_values.txt")).unwrap(), "hinge.angle=0.3\n");
+    let vars = mbfmu::fmi::variables::variables(
+        &mbfmu::model::parse::load_str(&model_text("pendulum.xml"), "p.xml").unwrap(),
+        &mbfmu::fmi::pack::read_layout(&dir.join("resources"), &guid_of(&xml)).unwrap(),
+    );
+    let vr = |n: &str| vars.iter().find(|v| v.name == n).unwrap().value_reference;
+    for host_value in [None, Some(-2.0)] {
+        let (c, _) = instantiate(&dir, &guid_of(&xml));
+        assert!(!c.is_null());
+        // SAFETY: a live instance and arrays of the stated lengths throughout.
+        unsafe {
+            assert_eq!(fmi2SetupExperiment(c, 1, 1e-10, 0.0, 0, 0.0), Status::Ok);
+            if let Some(v) = host_value {
+                assert_eq!(fmi2SetReal(c, [vr("hinge.angle")].as_ptr(), 1, [v].as_ptr()), Status::Ok);
+            }
+            assert_eq!(fmi2EnterInitializationMode(c), Status::Ok);
+            assert_eq!(fmi2ExitInitializationMode(c), Status::Ok, "{:?}", messages(c));
+        }
+        let got = host::get(c, &[vr("hinge.angle"), vr("angle")]);
+        let want = host_value.unwrap_or(0.3);
+        assert!((got[0] - want).abs() < 1e-12 && (got[1] - want).abs() < 1e-12, "{got:?} vs {want}");
+        free(c);
+    }
+    let o = mbfmu(&["pack", PENDULUM, "--out-dir", &arg(&scratch("pack-bad-state")), "--set", "hinge.angel=1"]);
+    assert_bad_input(&o, "did you mean 'hinge.angle'?");
+}

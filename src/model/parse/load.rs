@@ -103,6 +103,7 @@ fn empty_model(file: &str) -> Model {
         lin_velocities: Vec::new(),
         experiment: Experiment::default(),
         static_analysis: false,
+        state_starts: Vec::new(),
     }
 }
 
