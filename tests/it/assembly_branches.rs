@@ -380,3 +380,57 @@ fn the_move_warning_names_what_the_drawing_lacks_and_is_silent_for_what_was_aske
     assert!(w.starts_with("assembly moved body 'arm' by 3.000e-1 m"), "{w}");
     assert!(w.contains("the drawing disagrees with joint 'pin'"), "{w}");
 }
+
+fn ry(a: f64) -> M {
+    let (s, c) = a.sin_cos();
+    [[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]]
+}
+
+#[test]
+fn spherical_and_planar_coordinates_set_as_start_values_are_met_exactly() {
+    // A ball on a spherical joint at a tilted ground marker, and a puck on a planar joint:
+    // start values on yaw, pitch, roll (R = Rz Ry Rx relative to the marker, MODEL_FORMAT)
+    // and on dx, dy, angle, over random targets (pitch within ±60°, where the spherical
+    // coordinates are defined), give the body poses multiplied out here, to 1e-12.
+    let text = r#"<multibody name="sp" version="1">
+  <ground><marker name="S" position="0.1 0.2 0.3" euler313="0.3 0.4 0.5"/><marker name="Q" position="0 0 1" euler313="-0.7 0.2 0"/></ground>
+  <body name="ball" mass="1" inertia="0.1 0.2 0.3" position="0.1 0.2 0.3" euler313="0.3 0.4 0.5"/>
+  <body name="puck" mass="1" inertia="0.1 0.2 0.3" position="0 0 1" euler313="-0.7 0.2 0"/>
+  <joint name="ball_joint" type="spherical" i="ball.cm" j="ground.S"/>
+  <joint name="slide" type="planar" i="puck.cm" j="ground.Q"/>
+</multibody>"#;
+    let base = load_str(text, "sp.xml").unwrap();
+    let (rs, rq) = (euler(&[0.3, 0.4, 0.5]), euler(&[-0.7, 0.2, 0.0]));
+    let mut rng = Lcg(0x5eed_0004);
+    let mut worst = 0.0f64;
+    for _ in 0..50 {
+        let (yaw, pitch, roll) = (rng.range(-PI, PI), rng.range(-1.0, 1.0), rng.range(-PI, PI));
+        let (dx, dy, angle) = (rng.range(-0.5, 0.5), rng.range(-0.5, 0.5), rng.range(-PI, PI));
+        let mut m = base.clone();
+        m.state_starts = [
+            ("ball_joint.yaw", yaw),
+            ("ball_joint.pitch", pitch),
+            ("ball_joint.roll", roll),
+            ("slide.dx", dx),
+            ("slide.dy", dy),
+            ("slide.angle", angle),
+        ]
+        .iter()
+        .map(|(n, v)| (n.to_string(), *v))
+        .collect();
+        let opts = SimOptions { tol: 1e-10, max_step: None, ..Default::default() };
+        let s = Simulator::new(&m, opts, 0.0).unwrap_or_else(|e| panic!("{yaw} {pitch} {roll}: {e}"));
+        let ball = mm(&rs, &mm(&mm(&rz(yaw), &ry(pitch)), &rx(roll)));
+        let puck = mm(&rq, &rz(angle));
+        let puck_at = add(&[0.0, 0.0, 1.0], &mv(&rq, &[dx, dy, 0.0]));
+        let (b, p) = (s.body_state(0), s.body_state(1));
+        let pairs = b.rotation.iter().flatten().zip(ball.iter().flatten());
+        let pairs = pairs.chain(p.rotation.iter().flatten().zip(puck.iter().flatten()));
+        let pairs = pairs.chain(p.position.iter().zip(&puck_at)).chain(b.position.iter().zip(&[0.1, 0.2, 0.3]));
+        for (x, y) in pairs {
+            worst = worst.max((x - y).abs());
+        }
+        assert!(worst < 1e-12, "{yaw} {pitch} {roll} {dx} {dy} {angle}: error {worst:.3e}");
+    }
+    eprintln!("spherical and planar start values: largest error {worst:.3e}");
+}
