@@ -109,9 +109,9 @@ impl Simulator {
             return Err(EngineError::Numeric(format!("cannot integrate backwards from {} to {t_end}", self.radau.t)));
         }
         self.acc = None;
-        // Each call recomputes the Jacobian from (t, y): a communication point is a restart
-        // point, so a saved state (with the step history) reproduces the run exactly.
-        self.radau.restart();
+        // The step size, Jacobian and factorization carry over from the last interval (a
+        // saved state holds them, so a restored one reproduces the run bit for bit).
+        self.radau.new_interval();
         self.radau.advance(&mut self.dae, t_end).map_err(EngineError::Numeric)
     }
 

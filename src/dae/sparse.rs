@@ -5,8 +5,9 @@ use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::linalg::lu::{LuRef, LuSymbolicParams, NumericLu, SymbolicLu, factorize_symbolic_lu};
-use faer::sparse::{Argsort, Pair, SparseColMat, SymbolicSparseColMat};
-use faer::{Conj, Mat, MatMut, Par};
+use faer::sparse::{Pair, SparseColMatRef, SymbolicSparseColMat};
+use faer::traits::ComplexField;
+use faer::{Conj, Mat, MatMut, Par, c64};
 
 /// A matrix under construction, as (row, col, value) entries; duplicates are summed.
 #[derive(Clone, Debug, Default)]
@@ -44,23 +45,57 @@ impl Triplets {
 /// Right-hand sides solved at once by [`SparseLu::solve_columns`].
 const SOLVE_BLOCK: usize = 16;
 
+/// A scalar the LU factors: f64, or c64 for the complex-pair block of the integrator.
+pub trait LuScalar: ComplexField + Copy + std::ops::AddAssign {
+    /// Whether the value is finite.
+    fn finite(&self) -> bool;
+    /// Zero.
+    fn zero() -> Self;
+}
+
+impl LuScalar for f64 {
+    fn finite(&self) -> bool {
+        self.is_finite()
+    }
+    fn zero() -> Self {
+        0.0
+    }
+}
+
+impl LuScalar for c64 {
+    fn finite(&self) -> bool {
+        self.re.is_finite() && self.im.is_finite()
+    }
+    fn zero() -> Self {
+        c64::new(0.0, 0.0)
+    }
+}
+
 struct Symbolic {
     n: usize,
     pattern: Vec<Pair<usize, usize>>,
     mat: SymbolicSparseColMat<usize>,
-    argsort: Argsort<usize>,
+    /// Per entry of `pattern`: its slot in the compressed values (duplicates share one).
+    slot: Vec<usize>,
     lu: SymbolicLu<usize>,
 }
 
-/// A square sparse LU factorization that reuses its symbolic analysis and its scratch
-/// memory; sequential (no thread pool is touched inside a host process).
-#[derive(Default)]
-pub struct SparseLu {
+/// A square sparse LU factorization that reuses its symbolic analysis, its value buffer
+/// and its scratch memory (a refactorization with an unchanged pattern allocates
+/// nothing); sequential (no thread pool is touched inside a host process).
+pub struct SparseLu<T: LuScalar = f64> {
     symbolic: Option<Symbolic>,
-    numeric: Option<NumericLu<usize, f64>>,
+    values: Vec<T>,
+    numeric: Option<NumericLu<usize, T>>,
     scratch: Option<MemBuffer>,
     /// Number of symbolic analyses performed (for tests and benchmarks).
     pub analyses: usize,
+}
+
+impl<T: LuScalar> Default for SparseLu<T> {
+    fn default() -> Self {
+        SparseLu { symbolic: None, values: Vec::new(), numeric: None, scratch: None, analyses: 0 }
+    }
 }
 
 /// faer's LU variant: supernodal (the default: 2× faster than simplicial on the chains
@@ -74,7 +109,7 @@ fn supernodal_threshold() -> SupernodalThreshold {
     }
 }
 
-impl SparseLu {
+impl SparseLu<f64> {
     /// New, empty.
     pub fn new() -> Self {
         Self::default()
@@ -82,32 +117,31 @@ impl SparseLu {
 
     /// Factor the n×n matrix given by `t`.
     pub fn factor(&mut self, n: usize, t: &Triplets) -> Result<(), String> {
-        let reuse = matches!(&self.symbolic, Some(s) if s.n == n && s.pattern == t.idx);
+        self.factor_values(n, &t.idx, &t.vals)
+    }
+}
+
+impl<T: LuScalar> SparseLu<T> {
+    /// Factor the n×n matrix with entries `vals` at `idx` (duplicates summed). The
+    /// symbolic analysis is redone only when `idx` differs from the last one.
+    pub fn factor_values(&mut self, n: usize, idx: &[Pair<usize, usize>], vals: &[T]) -> Result<(), String> {
+        let reuse = matches!(&self.symbolic, Some(s) if s.n == n && s.pattern == idx);
         if !reuse {
-            let (mat, argsort) = SymbolicSparseColMat::try_new_from_indices(n, n, &t.idx)
-                .map_err(|e| format!("sparse pattern: {e:?}"))?;
-            let params =
-                LuSymbolicParams { supernodal_flop_ratio_threshold: supernodal_threshold(), ..Default::default() };
-            let lu = factorize_symbolic_lu(mat.as_ref(), params).map_err(|e| format!("symbolic LU: {e:?}"))?;
-            let req = StackReq::any_of(&[
-                lu.factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default()),
-                lu.solve_in_place_scratch::<f64>(1, Par::Seq),
-            ]);
-            self.scratch = Some(MemBuffer::try_new(req).map_err(|_| "out of memory".to_string())?);
-            self.symbolic = Some(Symbolic { n, pattern: t.idx.clone(), mat, argsort, lu });
-            self.numeric = Some(NumericLu::new());
-            self.analyses += 1;
+            self.analyze(n, idx)?;
         }
         let s = self.symbolic.as_ref().expect("symbolic analysis present");
-        let numeric = self.numeric.as_mut().expect("numeric storage present");
-        let scratch = self.scratch.as_mut().expect("scratch present");
-        if t.vals.iter().any(|v| !v.is_finite()) {
+        if vals.iter().any(|v| !v.finite()) {
             self.numeric = Some(NumericLu::new());
             return Err("matrix has non-finite entries".into());
         }
-        let a = SparseColMat::new_from_argsort(s.mat.clone(), &s.argsort, &t.vals)
-            .map_err(|e| format!("sparse values: {e:?}"))?;
-        match s.lu.factorize_numeric_lu(numeric, a.as_ref(), Par::Seq, MemStack::new(scratch), Default::default()) {
+        self.values.iter_mut().for_each(|v| *v = <T as LuScalar>::zero());
+        for (&k, &v) in s.slot.iter().zip(vals) {
+            self.values[k] += v;
+        }
+        let numeric = self.numeric.as_mut().expect("numeric storage present");
+        let scratch = self.scratch.as_mut().expect("scratch present");
+        let a = SparseColMatRef::new(s.mat.as_ref(), &self.values);
+        match s.lu.factorize_numeric_lu(numeric, a, Par::Seq, MemStack::new(scratch), Default::default()) {
             Ok(_) => Ok(()),
             Err(e) => {
                 // A failed factorization leaves the numeric part unusable: start afresh.
@@ -118,18 +152,66 @@ impl SparseLu {
         }
     }
 
+    /// The symbolic analysis of the pattern `idx`, with the slots of its entries.
+    fn analyze(&mut self, n: usize, idx: &[Pair<usize, usize>]) -> Result<(), String> {
+        let (mat, _) =
+            SymbolicSparseColMat::try_new_from_indices(n, n, idx).map_err(|e| format!("sparse pattern: {e:?}"))?;
+        let (col_ptr, row_idx) = (mat.col_ptr(), mat.row_idx());
+        let slot = idx
+            .iter()
+            .map(|p| {
+                let rows = &row_idx[col_ptr[p.col]..col_ptr[p.col + 1]];
+                col_ptr[p.col] + rows.binary_search(&p.row).expect("entry in its own pattern")
+            })
+            .collect();
+        let params = LuSymbolicParams { supernodal_flop_ratio_threshold: supernodal_threshold(), ..Default::default() };
+        let lu = factorize_symbolic_lu(mat.as_ref(), params).map_err(|e| format!("symbolic LU: {e:?}"))?;
+        let req = StackReq::any_of(&[
+            lu.factorize_numeric_lu_scratch::<T>(Par::Seq, Default::default()),
+            lu.solve_in_place_scratch::<T>(1, Par::Seq),
+        ]);
+        self.scratch = Some(MemBuffer::try_new(req).map_err(|_| "out of memory".to_string())?);
+        self.values = vec![<T as LuScalar>::zero(); row_idx.len()];
+        self.symbolic = Some(Symbolic { n, pattern: idx.to_vec(), mat, slot, lu });
+        self.numeric = Some(NumericLu::new());
+        self.analyses += 1;
+        Ok(())
+    }
+
     /// Solve A x = b in place; false if the result is not finite (singular matrix).
-    pub fn solve(&mut self, b: &mut [f64]) -> bool {
+    pub fn solve(&mut self, b: &mut [T]) -> bool {
         let n = b.len();
         let m = MatMut::from_column_major_slice_mut(b, n, 1);
         self.solve_mat(m)
     }
 
     /// Solve A X = B in place for several right-hand sides (columns of `b`).
-    pub fn solve_many(&mut self, b: &mut Mat<f64>) -> bool {
+    pub fn solve_many(&mut self, b: &mut Mat<T>) -> bool {
         self.solve_mat(b.as_mut())
     }
 
+    fn solve_mat(&mut self, mut b: MatMut<'_, T>) -> bool {
+        let (Some(s), Some(numeric)) = (&self.symbolic, &self.numeric) else { return false };
+        let req = s.lu.solve_in_place_scratch::<T>(b.ncols(), Par::Seq);
+        let mut local;
+        let buf = match &mut self.scratch {
+            Some(buf) if b.ncols() == 1 => buf,
+            _ => {
+                local = MemBuffer::new(req);
+                &mut local
+            }
+        };
+        LuRef::new_unchecked(&s.lu, numeric).solve_in_place_with_conj(
+            Conj::No,
+            b.as_mut(),
+            Par::Seq,
+            MemStack::new(buf),
+        );
+        (0..b.ncols()).all(|j| (0..b.nrows()).all(|i| b[(i, j)].finite()))
+    }
+}
+
+impl SparseLu<f64> {
     /// Solve A x = b for `ncols` right-hand sides without holding them all: `fill(j, b)`
     /// writes column j into a zeroed b, `take(j, x)` keeps what is needed of its
     /// solution. Columns go in blocks of `SOLVE_BLOCK` over `threads` threads (each
@@ -195,25 +277,5 @@ impl SparseLu {
             }
             Some(all)
         })
-    }
-
-    fn solve_mat(&mut self, mut b: MatMut<'_, f64>) -> bool {
-        let (Some(s), Some(numeric)) = (&self.symbolic, &self.numeric) else { return false };
-        let req = s.lu.solve_in_place_scratch::<f64>(b.ncols(), Par::Seq);
-        let mut local;
-        let buf = match &mut self.scratch {
-            Some(buf) if b.ncols() == 1 => buf,
-            _ => {
-                local = MemBuffer::new(req);
-                &mut local
-            }
-        };
-        LuRef::new_unchecked(&s.lu, numeric).solve_in_place_with_conj(
-            Conj::No,
-            b.as_mut(),
-            Par::Seq,
-            MemStack::new(buf),
-        );
-        (0..b.ncols()).all(|j| (0..b.nrows()).all(|i| b[(i, j)].is_finite()))
     }
 }
