@@ -19,6 +19,7 @@ mod bushing;
 mod cli;
 mod cli_linearize;
 mod cli_set;
+mod cli_stats;
 mod dependencies;
 mod elements;
 mod expr_derivatives;
