@@ -2,9 +2,10 @@
 # Robustness run (not a test of speed): the FMI call-sequence fuzzer of
 # tests/it/fmi_sequences.rs with many sequences (default 5000; CI runs 300). Each sequence
 # instantiates one example model (sometimes wrongly) and makes random legal and illegal
-# calls; the run fails on a crash, a panic inside an export, a call slower than 60 s, or
-# a non-finite value returned with fmi2OK. Prints the calls made, the statuses, the
-# slowest call and the successful calls per function.
+# calls; the run fails on a crash, a panic inside an export, a call making more
+# integrator step attempts than its solver.maxSteps, or a non-finite value returned with
+# fmi2OK. Prints the calls made, the statuses, the wall time, the busiest call (integrator
+# step attempts) and the successful calls per function.
 #   bench/fmi_sequences.sh [SEQUENCES] [SEED]
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -1,14 +1,17 @@
-//! `mbfmu simulate model.xml [--end T] [--step H] [--tol E] [--max-steps N] [--out result.csv] [--states]`:
-//! simulate and write time, every output (and every q and u) as CSV.
+//! `mbfmu simulate model.xml [--end T] [--step H] [--tol E] [--max-steps N] [--out result.csv] [--states] [--stats]`:
+//! simulate and write time, every output (and every q and u) as CSV; with `--stats` also
+//! the integrator's statistics and the wall time on stderr.
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::PathBuf;
+use std::time::{Duration, Instant};
 
 use clap::Args;
 
 use super::input_csv::InputTable;
 use super::{CliError, SetArgs};
+use crate::dae::radau::Stats;
 use crate::dae::{DEFAULT_MAX_STEPS, SimOptions, Simulator};
 use crate::model::Model;
 
@@ -44,6 +47,12 @@ pub struct SimulateArgs {
     /// Start from static equilibrium (as `<analysis static="true"/>`).
     #[arg(long = "static")]
     pub r#static: bool,
+    /// At the end of the run (also a failed one), print the integrator's statistics
+    /// (step attempts, accepted and rejected steps, Newton iterations, Jacobian
+    /// evaluations, factorizations, symbolic analyses, rhs evaluations; totals and per
+    /// communication step) and the wall time to stderr.
+    #[arg(long)]
+    pub stats: bool,
     /// Input signals: CSV with a `time` column and one column per input (linear between
     /// rows, as fmpy's input arrays).
     #[arg(long, value_name = "FILE")]
@@ -172,6 +181,7 @@ fn write_csv_row(out: &mut dyn Write, t: f64, values: &[f64]) -> std::io::Result
 
 /// Run `mbfmu simulate`; the CSV goes to `--out` or else to `stdout`.
 pub fn simulate(args: &SimulateArgs, stdout: &mut dyn Write) -> Result<(), CliError> {
+    let started = Instant::now();
     let mut model = args.set.load(&args.model)?;
     model.static_analysis |= args.r#static;
     let settings = RunSettings::resolve(&model, args.end, args.step, args.tol)?;
@@ -204,13 +214,83 @@ pub fn simulate(args: &SimulateArgs, stdout: &mut dyn Write) -> Result<(), CliEr
     };
     let io_err = |e| CliError::io(format!("writing {target}"), e);
 
+    let initialized = started.elapsed();
     writeln!(out, "{}", header(&sim, args.states).join(",")).map_err(io_err)?;
+    let mut rows = 0usize;
     let result = drive(&mut sim, &points, table.as_ref(), args.states, |t, values| {
+        rows += 1;
         write_csv_row(out, t, values).map_err(io_err)
     });
     // Keep the rows computed before a failure: flush either way, report the first error.
     let flushed = out.flush().map_err(io_err);
+    if args.stats {
+        // Communication steps completed (a row each, after the start's), and the one that
+        // failed, if any: the work counted was spent on all of them.
+        let done = rows.saturating_sub(1);
+        let taken = if result.is_err() && done + 1 < points.len() { done + 1 } else { done };
+        let report = StatsReport {
+            stats: sim.stats(),
+            communication_steps: taken,
+            failed: result.is_err(),
+            start: settings.start,
+            reached: sim.time(),
+            initialization: initialized,
+            total: started.elapsed(),
+        };
+        // Best effort, as the warnings: a closed stderr does not fail the run.
+        let _ = report.write(&mut std::io::stderr().lock());
+    }
     result.and(flushed)
+}
+
+/// What `simulate --stats` prints.
+struct StatsReport {
+    stats: Stats,
+    /// Communication steps taken (the failed one included).
+    communication_steps: usize,
+    failed: bool,
+    start: f64,
+    reached: f64,
+    /// Wall time to the start of integration (reading, checking, assembling the model).
+    initialization: Duration,
+    /// Wall time of the whole command.
+    total: Duration,
+}
+
+impl StatsReport {
+    /// One line per count: its label, the total, and the average per communication step.
+    fn write(&self, w: &mut dyn Write) -> std::io::Result<()> {
+        let s = &self.stats;
+        let n = self.communication_steps;
+        writeln!(
+            w,
+            "integrator statistics: {n} communication steps from t = {} to {}{}",
+            self.start,
+            self.reached,
+            if self.failed { " (the last failed)" } else { "" }
+        )?;
+        writeln!(w, "  {:<22} {:>12}  {:>14}", "", "total", "per comm. step")?;
+        let rows = [
+            ("steps attempted", s.steps),
+            ("accepted steps", s.accepted),
+            ("rejected steps", s.rejected),
+            ("Newton iterations", s.newton_iterations),
+            ("Jacobian evaluations", s.jacobians),
+            ("factorizations", s.factorizations),
+            ("symbolic analyses", s.symbolic_analyses),
+            ("rhs evaluations", s.rhs_evaluations),
+        ];
+        for (label, count) in rows {
+            let per = if n > 0 { format!("{:.2}", count as f64 / n as f64) } else { "-".to_string() };
+            writeln!(w, "  {:<22} {count:>12}  {per:>14}", format!("{label}:"))?;
+        }
+        let (init, total) = (self.initialization.as_secs_f64(), self.total.as_secs_f64());
+        writeln!(
+            w,
+            "wall time: {total:.3} s (initialization {init:.3} s, integration and output {:.3} s)",
+            total - init
+        )
+    }
 }
 
 #[cfg(test)]

@@ -4,8 +4,9 @@
 //! of once per file. Select a module with a filter: `cargo test --release --test it
 //! fmi_sequences::`, `cargo nextest run --release -E 'test(/^fmi_capi::/)'`.
 //!
-//! Only tests/memory_rss.rs is a crate of its own: it measures the whole process's
-//! resident set and heap, which the other tests' threads would disturb under `cargo test`.
+//! Only tests/memory_alloc.rs is a crate of its own: it counts the whole process's
+//! allocations (its own global allocator), which the other tests' threads would disturb
+//! under `cargo test`.
 
 mod common;
 
@@ -19,6 +20,7 @@ mod bushing;
 mod cli;
 mod cli_linearize;
 mod cli_set;
+mod cli_stats;
 mod dependencies;
 mod elements;
 mod expr_derivatives;

@@ -9,7 +9,7 @@ $CARGO_TARGET_DIR/release/mbfmu, else <repo>/target/release/mbfmu.
 import csv
 import os
 import subprocess
-from ctypes import CFUNCTYPE, c_char_p, c_int, c_void_p, cast
+from ctypes import CDLL, CFUNCTYPE, Structure, c_char_p, c_int, c_size_t, c_void_p, cast
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -157,10 +157,18 @@ def run_alone(p: Packed, tol: float, h: float, n: int, name: str = "alone", unzi
         s.freeInstance()
 
 
-def rss_bytes() -> int:
-    """Resident set size of this process (Linux /proc)."""
-    with open("/proc/self/status") as f:
-        for line in f:
-            if line.startswith("VmRSS:"):
-                return int(line.split()[1]) * 1024
-    raise RuntimeError("no VmRSS in /proc/self/status")
+_MALLINFO2_FIELDS = "arena ordblks smblks hblks hblkhd usmblks fsmblks uordblks fordblks keepcost".split()
+
+
+class _Mallinfo2(Structure):
+    _fields_ = [(name, c_size_t) for name in _MALLINFO2_FIELDS]
+
+
+def heap_bytes() -> int:
+    """Bytes malloc has handed out in this process and not got back (glibc mallinfo2:
+    arena chunks in use plus mmapped chunks): counted by the allocator, unlike the
+    resident set, which moves with pages. The FMU's library allocates through malloc."""
+    mallinfo2 = CDLL(None).mallinfo2  # glibc >= 2.33
+    mallinfo2.restype = _Mallinfo2
+    m = mallinfo2()
+    return m.uordblks + m.hblkhd

@@ -2,7 +2,7 @@
 //! whose logger records their messages; what an instance tells its logger and which state
 //! its answers show; and a resources directory for a model text. Everything goes through
 //! the exported FMI functions, as a host's would. A module of the integration tests
-//! (tests/it), also included with `#[path]` by tests/memory_rss.rs and
+//! (tests/it), also included with `#[path]` by tests/memory_alloc.rs and
 //! examples/fmu_lifecycle.rs (`common/mod.rs` is the engine-side helpers).
 
 #![allow(dead_code)]

@@ -6,8 +6,10 @@ pub mod host;
 
 use faer::linalg::solvers::Solve;
 use mbfmu::dae::init::consistent_accelerations;
+use mbfmu::dae::radau::Stats;
 use mbfmu::dae::sparse::SparseLu;
 use mbfmu::dae::{SimOptions, Simulator};
+use mbfmu::fmi::types::Component;
 use mbfmu::linearize::jets::{PositionFn, jets};
 use mbfmu::linearize::{Linearization, Selection, linearize, select_states};
 use mbfmu::mechanics::System;
@@ -90,6 +92,27 @@ pub fn mbfmu(args: &[&str]) -> Output {
         .stdin(Stdio::null())
         .output()
         .expect("the mbfmu binary runs")
+}
+
+/// The integrator statistics of the engine of FMU instance `c` and the instance's step
+/// limit (solver.maxSteps), read behind the C API (through the handle registry, as every
+/// export enters an instance), so that a test can bound the work a call did by counting it
+/// instead of timing it. None when `c` is not a live instance, is busy, or has no engine.
+pub fn engine_stats(c: Component) -> Option<(Stats, usize)> {
+    let mut session = mbfmu::fmi::handle::enter(c).ok()?;
+    let inst = session.instance();
+    let limit = inst.config.max_steps;
+    inst.built.as_ref().map(|b| (b.sim.stats(), limit))
+}
+
+/// Integrator step attempts made between two [`engine_stats`] readings of one instance
+/// (when the engine was rebuilt in between, its new count is all made since).
+pub fn attempts_between(before: Option<(Stats, usize)>, after: Option<(Stats, usize)>) -> usize {
+    match (before, after) {
+        (Some((b, _)), Some((a, _))) if a.steps >= b.steps => a.steps - b.steps,
+        (_, Some((a, _))) => a.steps,
+        (_, None) => 0,
+    }
 }
 
 /// The current value of output `name`.
