@@ -34,9 +34,7 @@ POSE = {"j1.angle": 0.5, "j2.angle": 0.5}
 
 def chain_xml(n: int) -> str:
     """bench/chain_model.sh N, as written."""
-    return subprocess.run(
-        [str(BENCH / "chain_model.sh"), str(n)], check=True, capture_output=True, text=True
-    ).stdout
+    return subprocess.run([str(BENCH / "chain_model.sh"), str(n)], check=True, capture_output=True, text=True).stdout
 
 
 def _with_outputs(xml: str, outputs: list[tuple[str, str]]) -> str:
@@ -95,7 +93,7 @@ class Chain:
             axis.append(_vec(markers["top"].get("z_axis")))
             tip_axis.append(_vec(markers["tip"].get("z_axis")))
         # each joint's two markers are drawn with the same axes (so the angle starts at 0)
-        assert all(np.array_equal(a, b) for a, b in zip(axis[1:], tip_axis[:-1]))
+        assert all(np.array_equal(a, b) for a, b in zip(axis[1:], tip_axis[:-1], strict=True))
         ground_o = root.find("ground").find("marker")
         assert np.array_equal(axis[0], _vec(ground_o.get("z_axis"))) and not _vec(ground_o.get("position")).any()
         inertia = np.array(inertia)

@@ -92,10 +92,10 @@ def main() -> None:
         )
 
         engines_timed = {
-            "mbfmu FMU": lambda: engines.mbfmu_fmu(str(fmu), tol=args.tol, step=h),
-            "mbfmu CLI": lambda: engines.mbfmu_cli(args.mbfmu, str(model), tol=args.tol, step=h),
-            "Exudyn": lambda: engines.exudyn_run(chain, theta, h=h),
-            "MuJoCo": lambda: engines.mujoco_run(chain, theta, dt=h),
+            "mbfmu FMU": lambda fmu=fmu: engines.mbfmu_fmu(str(fmu), tol=args.tol, step=h),
+            "mbfmu CLI": lambda model=model: engines.mbfmu_cli(args.mbfmu, str(model), tol=args.tol, step=h),
+            "Exudyn": lambda chain=chain, theta=theta: engines.exudyn_run(chain, theta, h=h),
+            "MuJoCo": lambda chain=chain, theta=theta: engines.mujoco_run(chain, theta, dt=h),
         }
         runs: dict[str, list[engines.Run]] = {k: [] for k in engines_timed}
         for rnd in range(args.repeats):
@@ -119,7 +119,18 @@ def main() -> None:
             r = engines.mbfmu_cli(args.mbfmu, str(model), tol=tol, step=h)
             e_end, e_max = errors(r, ref)
             ratio = (r.wall / med["mbfmu FMU"], r.wall / med["mbfmu CLI"])
-            rows.append((n, f"mbfmu simulate --step 1 ms, tol {tol:g}", r.wall, 1e6 * r.wall / r.steps, e_end, e_max, *ratio, "1 run"))
+            rows.append(
+                (
+                    n,
+                    f"mbfmu simulate --step 1 ms, tol {tol:g}",
+                    r.wall,
+                    1e6 * r.wall / r.steps,
+                    e_end,
+                    e_max,
+                    *ratio,
+                    "1 run",
+                )
+            )
 
         # Verification: the peers converge to the mbfmu reference (same model, pose, signs).
         print(f"  N={n}: verification runs ...", file=sys.stderr, flush=True)
