@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 import hashlib
+import os
 import statistics
 import sys
 import warnings
@@ -74,6 +75,10 @@ def main() -> None:
     ap.add_argument("--verify-max-n", type=int, default=100, help="MuJoCo at 0.1 ms only up to this N")
     ap.add_argument("--verify-exudyn-max-n", type=int, default=10, help="Exudyn at 0.1 ms only up to this N")
     args = ap.parse_args()
+    args.work = args.work.resolve()
+    if Path(args.mbfmu).exists():
+        args.mbfmu = str(Path(args.mbfmu).resolve())
+    os.chdir(args.work)  # MuJoCo writes MUJOCO_LOG.TXT into the working directory
     h = 1e-3
 
     rows: list[tuple] = []
