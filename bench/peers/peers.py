@@ -59,8 +59,11 @@ def errors(run: engines.Run, ref: engines.Run) -> tuple[float, float]:
     return e_end, e_max
 
 
-def fmt(x: float, spec: str) -> str:
-    return "-" if x is None or (isinstance(x, float) and np.isnan(x)) else format(x, spec)
+def row_text(row: tuple) -> str:
+    n, label, wall, us, e_end, e_max, r_fmu, r_cli, note = row
+    return (
+        f"{n:>4}  {label:<38} {wall:>9.3f} {us:>9.1f} {e_end:>11.2e} {e_max:>9.2e} {r_fmu:>7.3f} {r_cli:>7.3f}  {note}"
+    )
 
 
 def main() -> None:
@@ -80,6 +83,7 @@ def main() -> None:
         args.mbfmu = str(Path(args.mbfmu).resolve())
     os.chdir(args.work)  # MuJoCo writes MUJOCO_LOG.TXT into the working directory
     h = 1e-3
+    extra_tols = [float(x) for x in args.extra_tols.split(",") if x.strip()]
 
     rows: list[tuple] = []
     checks: list[str] = []
@@ -119,7 +123,7 @@ def main() -> None:
             extra = f"init {rs[0].extra['init_s']:.3f} s" if "init_s" in rs[0].extra else rs[0].extra.get("note", "")
             ratio = (med[name] / med["mbfmu FMU"], med[name] / med["mbfmu CLI"])
             rows.append((n, labels[name], med[name], 1e6 * med[name] / rs[0].steps, e_end, e_max, *ratio, extra))
-        for tol in [float(x) for x in args.extra_tols.split(",") if x.strip()]:
+        for tol in extra_tols:
             print(f"  N={n}: mbfmu CLI tol {tol:g} ...", file=sys.stderr, flush=True)
             r = engines.mbfmu_cli(args.mbfmu, str(model), tol=tol, step=h)
             e_end, e_max = errors(r, ref)
@@ -136,6 +140,9 @@ def main() -> None:
                     "1 run",
                 )
             )
+
+        for row in rows[-(len(runs) + len(extra_tols)) :]:  # as measured, in case a later N fails
+            print("  " + row_text(row), file=sys.stderr, flush=True)
 
         # Verification: the peers converge to the mbfmu reference (same model, pose, signs).
         print(f"  N={n}: verification runs ...", file=sys.stderr, flush=True)
@@ -166,11 +173,8 @@ def main() -> None:
     )
     print(head)
     print("-" * len(head))
-    for n, label, wall, us, e_end, e_max, r_fmu, r_cli, note in rows:
-        print(
-            f"{n:>4}  {label:<38} {wall:>9.3f} {us:>9.1f} {e_end:>11.2e} {e_max:>9.2e} "
-            f"{r_fmu:>7.3f} {r_cli:>7.3f}  {note}"
-        )
+    for row in rows:
+        print(row_text(row))
     print()
     print("Checks (same model, same start pose and sign convention in every engine):")
     for c in checks:
