@@ -46,6 +46,7 @@ pub mod force_laws;
 pub mod forces;
 pub mod from_model;
 pub mod joint_coords;
+pub mod joint_gradient;
 pub mod kernels;
 pub mod load_components;
 pub mod loads;

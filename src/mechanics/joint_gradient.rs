@@ -1,0 +1,214 @@
+//! C, C_q and the Hessians of a joint between markers on rigid bodies (or ground) in
+//! closed form. The integrator needs C and C_q at every evaluation of f(t, y) (the
+//! constraint rows and −Pᵀλ, −C_qᵀμ) and the Hessians at every Jacobian (Ċ_q, (Pᵀλ)_q),
+//! where the general dual-number kernels ([`super::kernels::constraint_first_ad`],
+//! nested duals for the Hessians) carry 13 (or 13 × 13) derivative lanes through every
+//! operation. Here each body's rotation and its three partial derivatives are formed once
+//! and the gradient is written out; the Hessians are that gradient differentiated by
+//! dual numbers over the element's 6 or 12 coordinates. The equations are those of
+//! [`super::constraint_equations`] (the model format's joint table); a test holds the
+//! two to round-off.
+
+use super::body::NQ;
+use super::constraints::{ConstraintEl, ConstraintKind};
+use super::coords::{gather, nql};
+use super::system::System;
+use crate::ad::chunked::seed;
+use crate::ad::{Dual, Real};
+use crate::geom::{M3, rot313};
+use crate::model::JointType;
+
+type V<T> = [T; 3];
+
+/// One equation of a joint, over the marker frames i and j and d = p_i − p_j.
+#[derive(Clone, Copy)]
+enum Row {
+    /// Component c of d.
+    D(usize),
+    /// Axis a of marker i · axis b of marker j.
+    Axes(usize, usize),
+    /// d · axis b of marker j.
+    DAxis(usize),
+}
+
+/// The equations of each joint type, in the order of the model format's table.
+fn equations(kind: JointType) -> &'static [Row] {
+    use Row::*;
+    match kind {
+        JointType::Fixed => &[D(0), D(1), D(2), Axes(2, 0), Axes(2, 1), Axes(0, 1)],
+        JointType::Revolute => &[D(0), D(1), D(2), Axes(2, 0), Axes(2, 1)],
+        JointType::Translational => &[Axes(2, 0), Axes(2, 1), Axes(0, 1), DAxis(0), DAxis(1)],
+        JointType::Cylindrical => &[Axes(2, 0), Axes(2, 1), DAxis(0), DAxis(1)],
+        JointType::Universal => &[D(0), D(1), D(2), Axes(2, 2)],
+        JointType::Spherical => &[D(0), D(1), D(2)],
+        JointType::Planar => &[Axes(2, 0), Axes(2, 1), DAxis(2)],
+    }
+}
+
+fn mv<T: Real>(m: &M3<T>, v: &V<T>) -> V<T> {
+    std::array::from_fn(|r| m.0[r][0] * v[0] + m.0[r][1] * v[1] + m.0[r][2] * v[2])
+}
+
+fn dot<T: Real>(a: &V<T>, b: &V<T>) -> T {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// A marker in ground: position, axes, and what its derivatives need.
+struct Frame<T: Real> {
+    /// First local column of its body's coordinates (None: ground).
+    col: Option<usize>,
+    p: V<T>,
+    /// Axes in ground (axes[k] = k-th axis).
+    axes: [V<T>; 3],
+    /// Offset and axes in body axes.
+    s: V<T>,
+    local_axes: [V<T>; 3],
+    /// ∂A/∂(ψ, θ, φ) of its body.
+    da: [M3<T>; 3],
+}
+
+impl<T: Real> Frame<T> {
+    /// Marker `m` of element `el` at the element's local coordinates `ql`.
+    fn new(sys: &System, el: &ConstraintEl, ql: &[T], m: usize) -> Frame<T> {
+        let g = &sys.markers[m];
+        let local_axes: [V<T>; 3] = std::array::from_fn(|k| std::array::from_fn(|r| T::cst(g.rot[r][k])));
+        let s = g.s.map(T::cst);
+        let Some(b) = g.body else {
+            return Frame { col: None, p: s, axes: local_axes, s, local_axes, da: [M3([[T::zero(); 3]; 3]); 3] };
+        };
+        let kb = el.bodies.iter().position(|&x| x == b).expect("a joint's marker body is one of its bodies");
+        let qb = &ql[NQ * kb..NQ * kb + NQ];
+        let r0 = M3::cst(&sys.r0[b]);
+        let a = r0.mm(&rot313(qb[3], qb[4], qb[5]));
+        let (o, z) = (T::one(), T::zero());
+        let (s1, c1, s2, c2, s3, c3) = (qb[3].sin(), qb[3].cos(), qb[4].sin(), qb[4].cos(), qb[5].sin(), qb[5].cos());
+        let rz = |s: T, c: T| M3([[c, -s, z], [s, c, z], [z, z, o]]);
+        let drz = |s: T, c: T| M3([[-s, -c, z], [c, -s, z], [z, z, z]]);
+        let rx = M3([[o, z, z], [z, c2, -s2], [z, s2, c2]]);
+        let drx = M3([[z, z, z], [z, -s2, -c2], [z, c2, -s2]]);
+        let da = [
+            r0.mm(&drz(s1, c1)).mm(&rx).mm(&rz(s3, c3)),
+            r0.mm(&rz(s1, c1)).mm(&drx).mm(&rz(s3, c3)),
+            r0.mm(&rz(s1, c1)).mm(&rx).mm(&drz(s3, c3)),
+        ];
+        let off = mv(&a, &s);
+        Frame {
+            col: Some(NQ * kb),
+            p: std::array::from_fn(|c| qb[c] + off[c]),
+            axes: std::array::from_fn(|k| mv(&a, &local_axes[k])),
+            s,
+            local_axes,
+            da,
+        }
+    }
+
+    /// Add `sign` · `w` · ∂(A v)/∂(its body's Euler angles) to the gradient row `g`, for
+    /// a vector `v` in body axes.
+    fn add_turn(&self, g: &mut [T], v: &V<T>, w: &V<T>, sign: f64) {
+        if let Some(c) = self.col {
+            for k in 0..3 {
+                g[c + 3 + k] += dot(w, &mv(&self.da[k], v)).scale(sign);
+            }
+        }
+    }
+
+    /// Add `sign` · `w` · ∂p/∂(its body's coordinates) to the gradient row `g`.
+    fn add_point(&self, g: &mut [T], w: &V<T>, sign: f64) {
+        if let Some(c) = self.col {
+            for k in 0..3 {
+                g[c + k] += w[k].scale(sign);
+            }
+            self.add_turn(g, &self.s, w, sign);
+        }
+    }
+}
+
+/// The markers (i, j) and type of `el` when it is a joint whose markers are on rigid
+/// bodies or ground (None: flexible nodes, other constraints).
+fn rigid_joint(sys: &System, el: &ConstraintEl) -> Option<(usize, usize, JointType)> {
+    let ConstraintKind::Joint { kind, i, j } = &el.kind else { return None };
+    let rigid = nql(sys, &el.bodies) == NQ * el.bodies.len();
+    let nodes = sys.markers[*i].node.is_some() || sys.markers[*j].node.is_some();
+    (rigid && !nodes && equations(*kind).len() == el.neq).then_some((*i, *j, *kind))
+}
+
+/// C and C_q (row-major neq × nq) of a rigid joint at local coordinates `ql`.
+fn rows<T: Real>(
+    sys: &System,
+    el: &ConstraintEl,
+    (i, j, kind): (usize, usize, JointType),
+    ql: &[T],
+) -> (Vec<T>, Vec<T>) {
+    let eqs = equations(kind);
+    let nq = ql.len();
+    let (fi, fj) = (Frame::new(sys, el, ql, i), Frame::new(sys, el, ql, j));
+    let d: V<T> = std::array::from_fn(|c| fi.p[c] - fj.p[c]);
+    let mut c = vec![T::zero(); eqs.len()];
+    let mut cq = vec![T::zero(); eqs.len() * nq];
+    for (e, eq) in eqs.iter().enumerate() {
+        let g = &mut cq[e * nq..(e + 1) * nq];
+        match *eq {
+            Row::D(k) => {
+                let unit: V<T> = std::array::from_fn(|r| if r == k { T::one() } else { T::zero() });
+                c[e] = d[k];
+                fi.add_point(g, &unit, 1.0);
+                fj.add_point(g, &unit, -1.0);
+            }
+            Row::Axes(a, b) => {
+                c[e] = dot(&fi.axes[a], &fj.axes[b]);
+                fi.add_turn(g, &fi.local_axes[a], &fj.axes[b], 1.0);
+                fj.add_turn(g, &fj.local_axes[b], &fi.axes[a], 1.0);
+            }
+            Row::DAxis(b) => {
+                c[e] = dot(&d, &fj.axes[b]);
+                fi.add_point(g, &fj.axes[b], 1.0);
+                fj.add_point(g, &fj.axes[b], -1.0);
+                fj.add_turn(g, &fj.local_axes[b], &d, 1.0);
+            }
+        }
+    }
+    (c, cq)
+}
+
+/// C and C_q (local, row-major neq × nq; C_t is zero: a joint does not depend on time)
+/// of `el` when it is a joint whose markers are on rigid bodies or ground; None
+/// otherwise, for the general kernel.
+pub fn joint_first(sys: &System, el: &ConstraintEl, q: &[f64]) -> Option<(Vec<f64>, Vec<f64>)> {
+    let joint = rigid_joint(sys, el)?;
+    Some(rows(sys, el, joint, &gather(sys, &el.bodies, q)))
+}
+
+/// C, its gradient (neq × k) and Hessians (neq × k × k) over z = (local q, t), k = nq + 1
+/// (the t entries are zero).
+pub type Second = (Vec<f64>, Vec<f64>, Vec<f64>);
+
+/// The [`Second`] derivatives of `el` when it is a joint whose markers are on rigid
+/// bodies or ground, between at most two bodies; None otherwise.
+pub fn joint_second(sys: &System, el: &ConstraintEl, q: &[f64]) -> Option<Second> {
+    let joint = rigid_joint(sys, el)?;
+    let ql = gather(sys, &el.bodies, q);
+    match ql.len() {
+        0 => None,
+        6 => Some(second::<6>(sys, el, joint, &ql)),
+        12 => Some(second::<12>(sys, el, joint, &ql)),
+        _ => None,
+    }
+}
+
+fn second<const K: usize>(sys: &System, el: &ConstraintEl, joint: (usize, usize, JointType), ql: &[f64]) -> Second {
+    let nq = ql.len();
+    let k = nq + 1;
+    let x: Vec<Dual<f64, K>> = seed(ql, 0, &(0..K));
+    let (c, cq) = rows(sys, el, joint, &x);
+    let (mut grad, mut hess) = (vec![0.0; c.len() * k], vec![0.0; c.len() * k * k]);
+    for e in 0..c.len() {
+        for a in 0..nq {
+            let g = &cq[e * nq + a];
+            grad[e * k + a] = g.v;
+            for b in 0..nq {
+                hess[e * k * k + a * k + b] = g.d[b];
+            }
+        }
+    }
+    (c.iter().map(|v| v.v).collect(), grad, hess)
+}
