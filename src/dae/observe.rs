@@ -32,6 +32,14 @@ impl Simulator {
 
     /// Values of the `<output>`s at the current time.
     pub fn outputs(&mut self) -> Result<Vec<f64>, EngineError> {
+        if !self.outputs_need_acc && self.acc.is_none() {
+            // Positions and velocities only: no acceleration solve.
+            let sys = &self.dae.sys;
+            let ids: Vec<usize> = (0..sys.nb()).collect();
+            let inputs = self.ext();
+            let ctx = LocalCtx::new(sys, &ids, self.q(), self.u(), &[], self.radau.t, &inputs);
+            return Ok(sys.outputs.iter().zip(&sys.output_bases).map(|(e, &b)| ctx.eval_expr(e, b)).collect());
+        }
         let (udot, lam) = self.accelerations()?;
         let sys = &self.dae.sys;
         let ids: Vec<usize> = (0..sys.nb()).collect();

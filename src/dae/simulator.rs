@@ -24,6 +24,9 @@ pub struct Simulator {
     pub(super) acc: Option<(Vec<f64>, Vec<f64>)>,
     /// What initialization wants the user to know (bodies that assembly moved far).
     warnings: Vec<String>,
+    /// Whether an output reads accelerations, loads (λ) or user unknowns: only then do
+    /// outputs need the acceleration solve (a KKT factorization per communication point).
+    pub(super) outputs_need_acc: bool,
 }
 
 impl Simulator {
@@ -82,7 +85,11 @@ impl Simulator {
         }
         radau.max_steps = opts.max_steps.max(1);
         let warnings = assembly_moves(model, &dae.sys.q_init, &assembly);
-        Ok(Simulator { dae, radau, acc_lu, acc: Some((udot, lam)), warnings })
+        let outputs_need_acc = dae.sys.outputs.iter().any(|e| {
+            let d = crate::model::expr::deps(e);
+            d.level >= 2 || !d.loads.is_empty() || !d.variables.is_empty() || !d.diff_dots.is_empty()
+        });
+        Ok(Simulator { dae, radau, acc_lu, acc: Some((udot, lam)), warnings, outputs_need_acc })
     }
 
     /// Current time.
