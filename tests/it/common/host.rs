@@ -241,10 +241,14 @@ pub fn resources_of(path: &std::path::Path, tag: &str) -> (PathBuf, CString) {
 /// it when done, if wanted) and the resource location's `file://` URI, with the space and
 /// the `%` of the path escaped as a host must.
 pub fn resources(text: &str, tag: &str) -> (PathBuf, CString) {
+    // The layout carries the GUID, which names this build of the engine: hashing it with the
+    // text keeps a directory left by another build under a reused process id from being read.
+    let layout = mbfmu::fmi::pack::layout_file(text, "model.xml").ok().map(|(l, _)| l);
     let id = {
         use std::hash::{Hash, Hasher};
         let mut h = std::collections::hash_map::DefaultHasher::new();
         text.hash(&mut h);
+        layout.hash(&mut h);
         format!("{:016x}", h.finish())
     };
     let top = std::env::temp_dir().join(format!("mbfmu {tag} 100% {} {id}", std::process::id()));
@@ -255,7 +259,7 @@ pub fn resources(text: &str, tag: &str) -> (PathBuf, CString) {
         // Write then rename: tests running in parallel never read a half-written file.
         let tmp = dir.join(format!("model.{:?}.tmp", std::thread::current().id()));
         // The layout first: model.xml present means both are.
-        if let Ok((layout, _)) = mbfmu::fmi::pack::layout_file(text, "model.xml") {
+        if let Some(layout) = layout {
             std::fs::write(&tmp, layout).unwrap_or_else(|e| panic!("{}: {e}", tmp.display()));
             let to = dir.join(mbfmu::fmi::pack::LAYOUT_FILE);
             std::fs::rename(&tmp, &to).unwrap_or_else(|e| panic!("{}: {e}", to.display()));
