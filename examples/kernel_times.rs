@@ -1,7 +1,7 @@
 //! Time the integrator's kernels on a model at its initial point (benchmark aid):
 //! f(t, y), J = ∂f/∂y, and the sparse LU of a matrix with J's pattern.
 //! Usage: cargo run --release --example kernel_times -- model.xml
-use mbfmu::dae::equations::{Layout, jacobian, rhs};
+use mbfmu::dae::equations::{Layout, RhsScratch, jacobian, rhs};
 use mbfmu::dae::sparse::{SparseLu, Triplets};
 use mbfmu::dae::{SimOptions, Simulator};
 use mbfmu::model::parse::load_file;
@@ -15,7 +15,7 @@ fn main() {
     let lay = Layout::of(sys);
     let y = sim.snapshot().y;
     let inputs = sim.inputs();
-    let mut f = vec![0.0; y.len()];
+    let (mut f, mut ws) = (vec![0.0; y.len()], RhsScratch::default());
     let time = |name: &str, reps: usize, mut work: Box<dyn FnMut() + '_>| {
         let t0 = Instant::now();
         for _ in 0..reps {
@@ -23,7 +23,7 @@ fn main() {
         }
         println!("{name}: {:.1} us", t0.elapsed().as_secs_f64() / reps as f64 * 1e6);
     };
-    time("rhs", 2000, Box::new(|| rhs(sys, lay, 0.0, &y, &inputs, &mut f)));
+    time("rhs", 2000, Box::new(|| rhs(sys, lay, 0.0, &y, &inputs, &mut ws, &mut f)));
     let mut j = Triplets::new();
     time(
         "jacobian",

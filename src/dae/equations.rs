@@ -12,7 +12,7 @@
 
 pub use super::jacobian::jacobian;
 pub use super::layout::Layout;
-pub use super::residual::rhs;
+pub use super::residual::{RhsScratch, rhs};
 use super::sparse::Triplets;
 use crate::mechanics::System;
 use crate::mechanics::mass::{body_mass_entries, constant_mass};

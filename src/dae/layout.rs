@@ -191,7 +191,13 @@ impl Layout {
     }
     /// The external values [inputs; Z; L] of state `y` at time `t` (see [`System::ext`]).
     pub fn ext(&self, sys: &System, inputs: &[f64], y: &[f64], t: f64) -> Vec<f64> {
+        let mut e = Vec::new();
+        self.ext_into(sys, inputs, y, t, &mut e);
+        e
+    }
+    /// [`Layout::ext`] into `e` (its capacity reused).
+    pub fn ext_into(&self, sys: &System, inputs: &[f64], y: &[f64], t: f64, e: &mut Vec<f64>) {
         let state = (&y[self.q_range()], &y[self.u_range()], &y[self.lam_range()]);
-        sys.ext(inputs, &y[self.z_range()], Some(state), t)
+        sys.ext_into(inputs, &y[self.z_range()], Some(state), t, e);
     }
 }

@@ -4,6 +4,7 @@
 
 use super::equations::{self, Layout};
 use super::radau::DaeProblem;
+use super::residual::RhsScratch;
 use super::sparse::Triplets;
 use crate::mechanics::System;
 
@@ -17,6 +18,9 @@ pub(super) struct MultibodyDae {
     pub(super) inputs: Vec<f64>,
     pub(super) slopes: Vec<f64>,
     pub(super) t_in: f64,
+    /// The inputs at the time of the last [`DaeProblem::rhs`], and that function's buffers.
+    inputs_now: Vec<f64>,
+    ws: RhsScratch,
 }
 
 impl DaeProblem for MultibodyDae {
@@ -24,7 +28,8 @@ impl DaeProblem for MultibodyDae {
         self.lay.dim()
     }
     fn rhs(&mut self, t: f64, y: &[f64], f: &mut [f64]) -> Result<(), String> {
-        equations::rhs(&self.sys, self.lay, t, y, &self.inputs_at(t), f);
+        interpolate(&self.inputs, &self.slopes, t - self.t_in, &mut self.inputs_now);
+        equations::rhs(&self.sys, self.lay, t, y, &self.inputs_now, &mut self.ws, f);
         if f.iter().all(|v| v.is_finite()) { Ok(()) } else { Err("non-finite equations".into()) }
     }
     fn jacobian(&mut self, t: f64, y: &[f64], j: &mut Triplets) -> Result<(), String> {
@@ -50,8 +55,22 @@ impl DaeProblem for MultibodyDae {
 }
 
 impl MultibodyDae {
+    /// The DAE of `sys` (laid out by `lay`) with inputs `inputs` at `t_in`, changing at
+    /// `slopes`.
+    pub(super) fn new(sys: System, lay: Layout, inputs: Vec<f64>, slopes: Vec<f64>, t_in: f64) -> MultibodyDae {
+        MultibodyDae { sys, lay, inputs, slopes, t_in, inputs_now: Vec::new(), ws: RhsScratch::default() }
+    }
+
     /// Inputs at time t: held values plus slope · (t − t_in).
     pub(super) fn inputs_at(&self, t: f64) -> Vec<f64> {
-        self.inputs.iter().zip(&self.slopes).map(|(v, s)| v + s * (t - self.t_in)).collect()
+        let mut v = Vec::new();
+        interpolate(&self.inputs, &self.slopes, t - self.t_in, &mut v);
+        v
     }
+}
+
+/// `values` + `slopes` · `dt` into `out` (its capacity reused).
+fn interpolate(values: &[f64], slopes: &[f64], dt: f64, out: &mut Vec<f64>) {
+    out.clear();
+    out.extend(values.iter().zip(slopes).map(|(v, s)| v + s * dt));
 }

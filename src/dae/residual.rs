@@ -2,13 +2,35 @@
 //! function per block of equations.
 
 use super::layout::Layout;
+use crate::geom::V3;
 use crate::mechanics::System;
-use crate::mechanics::body::{NQ, qdot};
-use crate::mechanics::constraint_jacobian::constraint_jacobian;
+use crate::mechanics::body::{NQ, Turn, body_turns, qdot_with};
+use crate::mechanics::constraint_jacobian::p_row_into;
 use crate::mechanics::coords::{gather, global_column};
 use crate::mechanics::flexible;
-use crate::mechanics::kernels::{force_values, gyroscopic, nonholonomic_first, user_residual};
-use crate::mechanics::mass::body_mass_times;
+use crate::mechanics::kernels::{
+    ConstraintFirst, constraint_first_into, force_values, gyroscopic_force, nonholonomic_first, user_residual,
+};
+use crate::mechanics::mass::body_mass_times_into;
+
+/// The buffers [`rhs`] works in, owned by its caller and reused from call to call: after
+/// the first call, f of a model of rigid bodies and joints allocates nothing (force
+/// elements, user rows, non-holonomic elements, flexible bodies and constraints other
+/// than rigid joints still allocate inside their kernels).
+#[derive(Clone, Debug, Default)]
+pub struct RhsScratch {
+    /// The external values.
+    ext: Vec<f64>,
+    /// The [`Turn`] of every body at q.
+    turns: Vec<Turn<f64>>,
+    /// C, C_q, C_t of one constraint element.
+    first: ConstraintFirst,
+    /// One row of P.
+    p: Vec<f64>,
+    /// One acceleration body's accelerations a, and M a.
+    acc: Vec<f64>,
+    ma: Vec<f64>,
+}
 
 /// Applied generalized forces Q(u, q, t): gravity, gyroscopic terms and force elements.
 pub fn applied_forces(sys: &System, q: &[f64], u: &[f64], t: f64, inputs: &[f64], out: &mut [f64]) {
@@ -26,8 +48,8 @@ pub fn applied_forces(sys: &System, q: &[f64], u: &[f64], t: f64, inputs: &[f64]
         for c in 0..3 {
             out[o + c] = body.mass * sys.gravity[c];
         }
-        let (g, _) = gyroscopic(&body.inertia, &u[o + 3..o + 6]);
-        out[o + 3..o + 6].copy_from_slice(&g);
+        let g = gyroscopic_force(&body.inertia, &V3([u[o + 3], u[o + 4], u[o + 5]]));
+        out[o + 3..o + 6].copy_from_slice(&g.0);
     }
     for el in &sys.forces {
         let v = force_values(sys, el, q, u, t, inputs);
@@ -37,21 +59,22 @@ pub fn applied_forces(sys: &System, q: &[f64], u: &[f64], t: f64, inputs: &[f64]
     }
 }
 
-/// f(t, y) of the stabilized index-2 system.
-pub fn rhs(sys: &System, lay: Layout, t: f64, y: &[f64], inputs: &[f64], f: &mut [f64]) {
+/// f(t, y) of the stabilized index-2 system, computed in the buffers `ws`.
+pub fn rhs(sys: &System, lay: Layout, t: f64, y: &[f64], inputs: &[f64], ws: &mut RhsScratch, f: &mut [f64]) {
     let (q, u) = (&y[lay.q_range()], &y[lay.u_range()]);
-    let ext = lay.ext(sys, inputs, y, t);
-    user_rows(sys, lay, t, y, &ext, f);
-    for b in 0..sys.nb() {
+    lay.ext_into(sys, inputs, y, t, &mut ws.ext);
+    body_turns(&sys.r0, q, &mut ws.turns);
+    user_rows(sys, lay, t, y, &ws.ext, f);
+    for (b, turn) in ws.turns.iter().enumerate() {
         let o = NQ * b;
-        f[o..o + NQ].copy_from_slice(&qdot(&q[o..o + NQ], &u[o..o + NQ])); // Eq. 13b
+        f[o..o + NQ].copy_from_slice(&qdot_with(&turn.h, &u[o..o + NQ])); // Eq. 13b
     }
     let modal = sys.modal_columns();
     f[modal.clone()].copy_from_slice(&u[modal]); // η̇ = u_η
-    applied_forces(sys, q, u, t, &ext, &mut f[lay.u_range()]);
-    nonholonomic_rows(sys, lay, t, y, &ext, f);
-    constraint_rows(sys, lay, t, y, &ext, f);
-    acceleration_rows(sys, lay, y, f);
+    applied_forces(sys, q, u, t, &ws.ext, &mut f[lay.u_range()]);
+    nonholonomic_rows(sys, lay, t, y, &ws.ext, f);
+    constraint_rows(sys, lay, t, y, ws, f);
+    acceleration_rows(sys, lay, y, ws, f);
 }
 
 /// X' = Ẋ, and the user rows r(q, u, Z, v, t) (Eq. 7a–7b).
@@ -81,43 +104,48 @@ fn nonholonomic_rows(sys: &System, lay: Layout, t: f64, y: &[f64], ext: &[f64], 
 }
 
 /// C (Eq. 13e, λ rows), Ċ = P u + C_t (Eq. 13d, μ rows), −Pᵀλ in the force balance and
-/// −C_qᵀμ in q̇ (the GGL term, Eq. 13b). A redundant row has λ = μ = 0 instead.
-fn constraint_rows(sys: &System, lay: Layout, t: f64, y: &[f64], ext: &[f64], f: &mut [f64]) {
+/// −C_qᵀμ in q̇ (the GGL term, Eq. 13b), element by element with P = C_q H (Eq. 13a) of
+/// each row formed in place. A redundant row has λ = μ = 0 instead.
+fn constraint_rows(sys: &System, lay: Layout, t: f64, y: &[f64], ws: &mut RhsScratch, f: &mut [f64]) {
     let (q, u) = (&y[lay.q_range()], &y[lay.u_range()]);
     let (nu, nl, nm) = (lay.u(), lay.lam(), lay.mu());
-    let cq = constraint_jacobian(sys, q, t, ext);
-    let p = cq.velocity_form(q);
-    let mut pu = vec![0.0; sys.m];
-    for (&(row, g, pv), &(_, _, cv)) in p.entries.iter().zip(&cq.entries) {
-        if sys.redundant[row] {
-            continue;
-        }
-        pu[row] += pv * u[g];
-        f[nu + g] -= pv * y[nl + row];
-        f[g] -= cv * y[nm + row];
-    }
-    for row in 0..sys.m {
-        if sys.redundant[row] {
-            f[nl + row] = y[nl + row];
-            f[nm + row] = y[nm + row];
-        } else {
-            f[nl + row] = cq.c[row];
-            f[nm + row] = pu[row] + cq.ct[row];
+    let RhsScratch { ext, turns, first, p, .. } = ws;
+    for el in &sys.constraints {
+        constraint_first_into(sys, el, q, t, ext, Some(turns), first);
+        let nql = first.cq.len() / el.neq.max(1);
+        p.resize(nql, 0.0);
+        for e in 0..el.neq {
+            let row = el.row + e;
+            if sys.redundant[row] {
+                f[nl + row] = y[nl + row];
+                f[nm + row] = y[nm + row];
+                continue;
+            }
+            let cq = &first.cq[e * nql..(e + 1) * nql];
+            p_row_into(&el.bodies, |b| turns[b].h, cq, p);
+            let (lam, mu, mut pu) = (y[nl + row], y[nm + row], 0.0);
+            for (a, (&pv, &cv)) in p.iter().zip(cq).enumerate() {
+                let g = global_column(sys, &el.bodies, a);
+                pu += pv * u[g];
+                f[nu + g] -= pv * lam;
+                f[g] -= cv * mu;
+            }
+            f[nl + row] = first.c[e];
+            f[nm + row] = pu + first.ct[e];
         }
     }
 }
 
 /// Bodies with acceleration unknowns: u' = a, and M a = Q − Pᵀλ − Bᵀν as algebraic rows
 /// (their force balance computed above moves there).
-fn acceleration_rows(sys: &System, lay: Layout, y: &[f64], f: &mut [f64]) {
+fn acceleration_rows(sys: &System, lay: Layout, y: &[f64], ws: &mut RhsScratch, f: &mut [f64]) {
     let q = &y[lay.q_range()];
     for &b in &sys.acc_bodies {
-        let dofs = sys.body_dofs(b);
-        let rows: Vec<usize> = dofs.iter().map(|&g| lay.force_row(&sys.acc_bodies, g)).collect();
-        let a: Vec<f64> = rows.iter().map(|&r| y[r]).collect();
-        let ma = body_mass_times(sys, b, q, &a);
-        for ((&g, &ra), m) in dofs.iter().zip(&rows).zip(ma) {
-            let o = lay.u() + g;
+        ws.acc.clear();
+        ws.acc.extend(sys.body_dofs_iter(b).map(|g| y[lay.force_row(&sys.acc_bodies, g)]));
+        body_mass_times_into(sys, b, q, &ws.acc, &mut ws.ma);
+        for (g, m) in sys.body_dofs_iter(b).zip(&ws.ma) {
+            let (ra, o) = (lay.force_row(&sys.acc_bodies, g), lay.u() + g);
             f[ra] = f[o] - m;
             f[o] = y[ra];
         }

@@ -77,7 +77,7 @@ impl Simulator {
             .map_err(EngineError::Numeric)?;
         let mut y = lay.assemble(&q, &u, &z, &lam);
         let slopes = vec![0.0; inputs.len()];
-        let mut dae = MultibodyDae { sys, lay, inputs, slopes, t_in: t0 };
+        let mut dae = MultibodyDae::new(sys, lay, inputs, slopes, t0);
         dae.accepted(t0, &mut y);
         let mut radau = Radau::new(&dae, t0, y, opts.tol);
         if let Some(h) = opts.max_step {

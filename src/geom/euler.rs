@@ -17,9 +17,12 @@ pub fn rot_z<T: Real>(a: T) -> M3<T> {
 
 /// R = Rz(ψ)·Rx(θ)·Rz(φ), written out.
 pub fn rot313<T: Real>(psi: T, theta: T, phi: T) -> M3<T> {
-    let (s1, c1) = (psi.sin(), psi.cos());
-    let (s2, c2) = (theta.sin(), theta.cos());
-    let (s3, c3) = (phi.sin(), phi.cos());
+    rot313_sc([psi.sin(), theta.sin(), phi.sin()], [psi.cos(), theta.cos(), phi.cos()])
+}
+
+/// [`rot313`] from the sines `s` and cosines `c` of (ψ, θ, φ).
+pub fn rot313_sc<T: Real>(s: [T; 3], c: [T; 3]) -> M3<T> {
+    let ([s1, s2, s3], [c1, c2, c3]) = (s, c);
     M3([
         [c1 * c3 - s1 * c2 * s3, -c1 * s3 - s1 * c2 * c3, s1 * s2],
         [s1 * c3 + c1 * c2 * s3, -s1 * s3 + c1 * c2 * c3, -c1 * s2],

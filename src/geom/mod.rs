@@ -5,6 +5,6 @@ mod euler;
 mod mat3;
 mod vec3;
 
-pub use euler::{euler313_from_matrix, omega_to_euler_rates, rot_x, rot_z, rot313, ypr_from_matrix};
+pub use euler::{euler313_from_matrix, omega_to_euler_rates, rot_x, rot_z, rot313, rot313_sc, ypr_from_matrix};
 pub use mat3::M3;
 pub use vec3::V3;

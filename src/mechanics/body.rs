@@ -3,7 +3,7 @@
 //! u = T(q) q̇ (Eq. 12) with T = blockdiag(I, B(θ, φ)); we use H = T⁻¹.
 
 use crate::ad::Real;
-use crate::geom::{M3, V3, rot_x, rot313};
+use crate::geom::{M3, V3, rot_x, rot313, rot313_sc};
 
 /// Number of coordinates (and velocities) per body.
 pub const NQ: usize = 6;
@@ -25,21 +25,75 @@ pub fn body_frame<T: Real>(q: &[T], r0: &[[f64; 3]; 3]) -> (V3<T>, M3<T>) {
 
 /// The angular block of H = T⁻¹ (Eq. 12): ė = Hω(θ, φ) ω'. Rows ψ̇ θ̇ φ̇, columns ω'x ω'y ω'z.
 pub fn h_angular<T: Real>(theta: T, phi: T) -> M3<T> {
-    let (s2, c2) = (theta.sin(), theta.cos());
-    let (s3, c3) = (phi.sin(), phi.cos());
+    h_angular_sc(theta.sin(), theta.cos(), phi.sin(), phi.cos())
+}
+
+/// [`h_angular`] from sin θ, cos θ, sin φ, cos φ.
+fn h_angular_sc<T: Real>(s2: T, c2: T, s3: T, c3: T) -> M3<T> {
     let z = T::zero();
     M3([[s3 / s2, c3 / s2, z], [c3, -s3, z], [-(c2 * s3) / s2, -(c2 * c3) / s2, T::one()]])
 }
 
+/// What a body's Euler angles give, from one sine and cosine of each: its rotation
+/// A = R0 · Rz(ψ)Rx(θ)Rz(φ), the partial derivatives ∂A/∂(ψ, θ, φ), and the angular
+/// block of H (Eq. 12). Computed once per body and evaluation, read by every element
+/// that touches the body.
+#[derive(Clone, Copy, Debug)]
+pub struct Turn<T: Real> {
+    /// A.
+    pub a: M3<T>,
+    /// ∂A/∂ψ, ∂A/∂θ, ∂A/∂φ.
+    pub da: [M3<T>; 3],
+    /// The angular block of H ([`h_angular`]).
+    pub h: M3<T>,
+}
+
+impl<T: Real> Turn<T> {
+    /// The turn of a body with reference frame `r0` at Euler angles `e` = (ψ, θ, φ).
+    pub fn of(r0: &[[f64; 3]; 3], e: &[T]) -> Turn<T> {
+        let s: [T; 3] = std::array::from_fn(|k| e[k].sin());
+        let c: [T; 3] = std::array::from_fn(|k| e[k].cos());
+        let ([s1, s2, s3], [c1, c2, c3]) = (s, c);
+        let (r0, o, z) = (M3::cst(r0), T::one(), T::zero());
+        let rz = |s: T, c: T| M3([[c, -s, z], [s, c, z], [z, z, o]]);
+        let drz = |s: T, c: T| M3([[-s, -c, z], [c, -s, z], [z, z, z]]);
+        let rx = M3([[o, z, z], [z, c2, -s2], [z, s2, c2]]);
+        let drx = M3([[z, z, z], [z, -s2, -c2], [z, c2, -s2]]);
+        let da = [
+            r0.mm(&drz(s1, c1)).mm(&rx).mm(&rz(s3, c3)),
+            r0.mm(&rz(s1, c1)).mm(&drx).mm(&rz(s3, c3)),
+            r0.mm(&rz(s1, c1)).mm(&rx).mm(&drz(s3, c3)),
+        ];
+        Turn { a: r0.mm(&rot313_sc(s, c)), da, h: h_angular_sc(s2, c2, s3, c3) }
+    }
+}
+
+/// The [`Turn`] of every body at global q (six coordinates per body; `r0`: the bodies'
+/// reference frames), into `out` (its capacity reused).
+pub fn body_turns(r0: &[[[f64; 3]; 3]], q: &[f64], out: &mut Vec<Turn<f64>>) {
+    out.clear();
+    out.extend(r0.iter().enumerate().map(|(b, r)| Turn::of(r, &q[NQ * b + 3..NQ * b + NQ])));
+}
+
 /// q̇_b = H(q_b) u_b for one body (Eq. 13b solved for q̇).
 pub fn qdot<T: Real>(q: &[T], u: &[T]) -> [T; NQ] {
-    let e = h_angular(q[4], q[5]).mv(&V3([u[3], u[4], u[5]]));
+    qdot_with(&h_angular(q[4], q[5]), u)
+}
+
+/// [`qdot`] with the body's angular block `h` of H given.
+pub fn qdot_with<T: Real>(h: &M3<T>, u: &[T]) -> [T; NQ] {
+    let e = h.mv(&V3([u[3], u[4], u[5]]));
     [u[0], u[1], u[2], e.0[0], e.0[1], e.0[2]]
 }
 
 /// Hᵀ w for one body: maps a row-vector of q-derivatives to u-space.
 pub fn h_transpose_times<T: Real>(q: &[T], w: &[T]) -> [T; NQ] {
-    let e = h_angular(q[4], q[5]).tv(&V3([w[3], w[4], w[5]]));
+    h_transpose_times_with(&h_angular(q[4], q[5]), w)
+}
+
+/// [`h_transpose_times`] with the body's angular block `h` of H given.
+pub fn h_transpose_times_with<T: Real>(h: &M3<T>, w: &[T]) -> [T; NQ] {
+    let e = h.tv(&V3([w[3], w[4], w[5]]));
     [w[0], w[1], w[2], e.0[0], e.0[1], e.0[2]]
 }
 

@@ -6,11 +6,12 @@
 //! Rows are numbered by the elements' `row` fields; every local entry is kept, zeros
 //! included, so the sparsity pattern does not change from one point to the next.
 
-use super::body::{NQ, h_transpose_times};
+use super::body::{NQ, h_angular, h_transpose_times, h_transpose_times_with};
 use super::constraints::ConstraintEl;
 use super::coords::{gather, global_column, nql, rates};
-use super::kernels::{constraint_first, constraint_second, dqdot_dq};
+use super::kernels::{ConstraintFirst, constraint_first_into, constraint_second, dqdot_dq};
 use super::system::System;
+use crate::geom::M3;
 
 /// Constraint rows of a set of elements at (q, t).
 #[derive(Clone, Debug, Default)]
@@ -29,12 +30,18 @@ pub struct ConstraintRows {
 /// P row of one equation (local coordinates, see [`super::coords`]) from its C_q row:
 /// P = C_q H (Eq. 13a); modal columns are unchanged (H = I there).
 pub fn p_row(bodies: &[usize], q: &[f64], cq: &[f64]) -> Vec<f64> {
-    let mut p = cq.to_vec();
+    let mut p = vec![0.0; cq.len()];
+    p_row_into(bodies, |b| h_angular(q[NQ * b + 4], q[NQ * b + 5]), cq, &mut p);
+    p
+}
+
+/// [`p_row`] into `p` (as long as `cq`), `h(b)` giving body b's angular block of H.
+pub fn p_row_into(bodies: &[usize], h: impl Fn(usize) -> M3<f64>, cq: &[f64], p: &mut [f64]) {
+    p.copy_from_slice(cq);
     for (k, &b) in bodies.iter().enumerate() {
-        let r = h_transpose_times(&q[NQ * b..NQ * b + NQ], &cq[NQ * k..NQ * k + NQ]);
+        let r = h_transpose_times_with(&h(b), &cq[NQ * k..NQ * k + NQ]);
         p[NQ * k..NQ * k + NQ].copy_from_slice(&r);
     }
-    p
 }
 
 /// C_q rows (Eq. 1b) of the elements `els` at (q, t), with C and C_t; `ext` holds the
@@ -43,8 +50,9 @@ pub fn constraint_rows(sys: &System, els: &[ConstraintEl], q: &[f64], t: f64, ex
     let nrows = els.iter().map(|e| e.row + e.neq).max().unwrap_or(0);
     let body_cols = sys.modal_columns().start;
     let mut out = ConstraintRows { c: vec![0.0; nrows], ct: vec![0.0; nrows], entries: Vec::new(), body_cols };
+    let mut f = ConstraintFirst::default();
     for el in els {
-        let f = constraint_first(sys, el, q, t, ext);
+        constraint_first_into(sys, el, q, t, ext, None, &mut f);
         let nql = nql(sys, &el.bodies);
         for e in 0..el.neq {
             let row = el.row + e;
@@ -111,7 +119,7 @@ impl ConstraintRows {
             }
             let chunk = &self.entries[i..i + NQ];
             debug_assert!(chunk.iter().enumerate().all(|(k, e)| e.0 == row && e.1 == c0 + k));
-            let cq: Vec<f64> = chunk.iter().map(|e| e.2).collect();
+            let cq: [f64; NQ] = std::array::from_fn(|k| chunk[k].2);
             let p = h_transpose_times(&q[c0..c0 + NQ], &cq);
             entries.extend(p.iter().enumerate().map(|(k, &v)| (row, c0 + k, v)));
             i += NQ;

@@ -9,13 +9,13 @@
 //! [`super::constraint_equations`] (the model format's joint table); a test holds the
 //! two to round-off.
 
-use super::body::NQ;
+use super::body::{NQ, Turn};
 use super::constraints::{ConstraintEl, ConstraintKind};
 use super::coords::{gather, nql};
 use super::system::System;
 use crate::ad::chunked::seed;
 use crate::ad::{Dual, Real};
-use crate::geom::{M3, rot313};
+use crate::geom::M3;
 use crate::model::JointType;
 
 type V<T> = [T; 3];
@@ -68,8 +68,18 @@ struct Frame<T: Real> {
 }
 
 impl<T: Real> Frame<T> {
-    /// Marker `m` of element `el` at the element's local coordinates `ql`.
-    fn new(sys: &System, el: &ConstraintEl, ql: &[T], m: usize) -> Frame<T> {
+    /// Marker `m` of element `el`; `qb(k)` gives the six coordinates of the element's
+    /// local body k, `turns` the [`Turn`] of every body (None: computed here from `qb`).
+    fn new<'q>(
+        sys: &System,
+        el: &ConstraintEl,
+        m: usize,
+        qb: impl Fn(usize) -> &'q [T],
+        turns: Option<&[Turn<T>]>,
+    ) -> Frame<T>
+    where
+        T: 'q,
+    {
         let g = &sys.markers[m];
         let local_axes: [V<T>; 3] = std::array::from_fn(|k| std::array::from_fn(|r| T::cst(g.rot[r][k])));
         let s = g.s.map(T::cst);
@@ -77,28 +87,23 @@ impl<T: Real> Frame<T> {
             return Frame { col: None, p: s, axes: local_axes, s, local_axes, da: [M3([[T::zero(); 3]; 3]); 3] };
         };
         let kb = el.bodies.iter().position(|&x| x == b).expect("a joint's marker body is one of its bodies");
-        let qb = &ql[NQ * kb..NQ * kb + NQ];
-        let r0 = M3::cst(&sys.r0[b]);
-        let a = r0.mm(&rot313(qb[3], qb[4], qb[5]));
-        let (o, z) = (T::one(), T::zero());
-        let (s1, c1, s2, c2, s3, c3) = (qb[3].sin(), qb[3].cos(), qb[4].sin(), qb[4].cos(), qb[5].sin(), qb[5].cos());
-        let rz = |s: T, c: T| M3([[c, -s, z], [s, c, z], [z, z, o]]);
-        let drz = |s: T, c: T| M3([[-s, -c, z], [c, -s, z], [z, z, z]]);
-        let rx = M3([[o, z, z], [z, c2, -s2], [z, s2, c2]]);
-        let drx = M3([[z, z, z], [z, -s2, -c2], [z, c2, -s2]]);
-        let da = [
-            r0.mm(&drz(s1, c1)).mm(&rx).mm(&rz(s3, c3)),
-            r0.mm(&rz(s1, c1)).mm(&drx).mm(&rz(s3, c3)),
-            r0.mm(&rz(s1, c1)).mm(&rx).mm(&drz(s3, c3)),
-        ];
-        let off = mv(&a, &s);
+        let qb = qb(kb);
+        let own;
+        let turn = match turns {
+            Some(t) => &t[b],
+            None => {
+                own = Turn::of(&sys.r0[b], &qb[3..NQ]);
+                &own
+            }
+        };
+        let off = mv(&turn.a, &s);
         Frame {
             col: Some(NQ * kb),
             p: std::array::from_fn(|c| qb[c] + off[c]),
-            axes: std::array::from_fn(|k| mv(&a, &local_axes[k])),
+            axes: std::array::from_fn(|k| mv(&turn.a, &local_axes[k])),
             s,
             local_axes,
-            da,
+            da: turn.da,
         }
     }
 
@@ -132,19 +137,13 @@ fn rigid_joint(sys: &System, el: &ConstraintEl) -> Option<(usize, usize, JointTy
     (rigid && !nodes && equations(*kind).len() == el.neq).then_some((*i, *j, *kind))
 }
 
-/// C and C_q (row-major neq × nq) of a rigid joint at local coordinates `ql`.
-fn rows<T: Real>(
-    sys: &System,
-    el: &ConstraintEl,
-    (i, j, kind): (usize, usize, JointType),
-    ql: &[T],
-) -> (Vec<T>, Vec<T>) {
+/// C and C_q (row-major neq × nq, into `c` and `cq`) of a rigid joint with marker frames
+/// `fi`, `fj`.
+fn rows<T: Real>(kind: JointType, fi: &Frame<T>, fj: &Frame<T>, c: &mut [T], cq: &mut [T]) {
     let eqs = equations(kind);
-    let nq = ql.len();
-    let (fi, fj) = (Frame::new(sys, el, ql, i), Frame::new(sys, el, ql, j));
-    let d: V<T> = std::array::from_fn(|c| fi.p[c] - fj.p[c]);
-    let mut c = vec![T::zero(); eqs.len()];
-    let mut cq = vec![T::zero(); eqs.len() * nq];
+    let nq = cq.len() / eqs.len();
+    cq.fill(T::zero());
+    let d: V<T> = std::array::from_fn(|k| fi.p[k] - fj.p[k]);
     for (e, eq) in eqs.iter().enumerate() {
         let g = &mut cq[e * nq..(e + 1) * nq];
         match *eq {
@@ -167,15 +166,34 @@ fn rows<T: Real>(
             }
         }
     }
-    (c, cq)
 }
 
 /// C and C_q (local, row-major neq × nq; C_t is zero: a joint does not depend on time)
 /// of `el` when it is a joint whose markers are on rigid bodies or ground; None
 /// otherwise, for the general kernel.
 pub fn joint_first(sys: &System, el: &ConstraintEl, q: &[f64]) -> Option<(Vec<f64>, Vec<f64>)> {
-    let joint = rigid_joint(sys, el)?;
-    Some(rows(sys, el, joint, &gather(sys, &el.bodies, q)))
+    rigid_joint(sys, el)?;
+    let (mut c, mut cq) = (vec![0.0; el.neq], vec![0.0; el.neq * nql(sys, &el.bodies)]);
+    joint_first_into(sys, el, q, None, &mut c, &mut cq);
+    Some((c, cq))
+}
+
+/// [`joint_first`] into `c` (neq) and `cq` (neq × nq), with the bodies' turns (global q,
+/// `turns` indexed by body; None: computed here); false (nothing written) when `el` is not
+/// such a joint.
+pub fn joint_first_into(
+    sys: &System,
+    el: &ConstraintEl,
+    q: &[f64],
+    turns: Option<&[Turn<f64>]>,
+    c: &mut [f64],
+    cq: &mut [f64],
+) -> bool {
+    let Some((i, j, kind)) = rigid_joint(sys, el) else { return false };
+    let qb = |k: usize| &q[NQ * el.bodies[k]..NQ * el.bodies[k] + NQ];
+    let (fi, fj) = (Frame::new(sys, el, i, qb, turns), Frame::new(sys, el, j, qb, turns));
+    rows(kind, &fi, &fj, c, cq);
+    true
 }
 
 /// C, its gradient (neq × k) and Hessians (neq × k × k) over z = (local q, t), k = nq + 1
@@ -199,7 +217,11 @@ fn second<const K: usize>(sys: &System, el: &ConstraintEl, joint: (usize, usize,
     let nq = ql.len();
     let k = nq + 1;
     let x: Vec<Dual<f64, K>> = seed(ql, 0, &(0..K));
-    let (c, cq) = rows(sys, el, joint, &x);
+    let (i, j, kind) = joint;
+    let qb = |k: usize| &x[NQ * k..NQ * k + NQ];
+    let (fi, fj) = (Frame::new(sys, el, i, qb, None), Frame::new(sys, el, j, qb, None));
+    let (mut c, mut cq) = (vec![Dual::zero(); el.neq], vec![Dual::zero(); el.neq * nq]);
+    rows(kind, &fi, &fj, &mut c, &mut cq);
     let (mut grad, mut hess) = (vec![0.0; c.len() * k], vec![0.0; c.len() * k * k]);
     for e in 0..c.len() {
         for a in 0..nq {

@@ -2,7 +2,7 @@
 //! coordinates. Each kernel seeds the coordinates of the (few) bodies an element touches,
 //! so the cost is independent of the model size and every Jacobian stays sparse.
 
-use super::body::{h_transpose_times, qdot};
+use super::body::{Turn, h_transpose_times, qdot};
 use super::constraints::ConstraintEl;
 use super::coords::{gather, nql};
 use super::forces::ForceEl;
@@ -13,9 +13,11 @@ use super::system::System;
 use super::user::UserEq;
 use crate::ad::chunked::{by_width, chunks, seed, seed_one};
 use crate::ad::{Dual, Real};
+use crate::geom::{M3, V3};
 use std::ops::Range;
 
 /// C, C_q (local, row-major neq × 6nb) and C_t of one constraint element.
+#[derive(Clone, Debug, Default)]
 pub struct ConstraintFirst {
     /// C (neq).
     pub c: Vec<f64>,
@@ -53,21 +55,54 @@ pub fn constraint_values(sys: &System, el: &ConstraintEl, q: &[f64], t: f64, inp
     out
 }
 
+impl ConstraintFirst {
+    /// All zero, for `neq` equations of `nq` local coordinates (the buffers' capacity reused).
+    fn reset(&mut self, neq: usize, nq: usize) {
+        for (v, len) in [(&mut self.c, neq), (&mut self.cq, neq * nq), (&mut self.ct, neq)] {
+            v.clear();
+            v.resize(len, 0.0);
+        }
+    }
+}
+
 /// First derivatives of a constraint element (Eq. 1b: C_q, C_t).
 /// Joints between rigid bodies take the closed form of [`super::joint_gradient`].
 pub fn constraint_first(sys: &System, el: &ConstraintEl, q: &[f64], t: f64, inputs: &[f64]) -> ConstraintFirst {
-    match joint_gradient::joint_first(sys, el, q) {
-        Some((c, cq)) => ConstraintFirst { ct: vec![0.0; c.len()], c, cq },
-        None => constraint_first_ad(sys, el, q, t, inputs),
+    let mut r = ConstraintFirst::default();
+    constraint_first_into(sys, el, q, t, inputs, None, &mut r);
+    r
+}
+
+/// [`constraint_first`] into `r`, with the bodies' turns given (`turns`, indexed by body;
+/// None: computed where needed). Allocates nothing once `r` has grown to the element's
+/// size, except for elements that take the dual-number kernel.
+pub fn constraint_first_into(
+    sys: &System,
+    el: &ConstraintEl,
+    q: &[f64],
+    t: f64,
+    inputs: &[f64],
+    turns: Option<&[Turn<f64>]>,
+    r: &mut ConstraintFirst,
+) {
+    r.reset(el.neq, nql(sys, &el.bodies));
+    if !joint_gradient::joint_first_into(sys, el, q, turns, &mut r.c, &mut r.cq) {
+        first_ad(sys, el, q, t, inputs, r);
     }
 }
 
 /// [`constraint_first`] by dual numbers, for every kind of element.
 pub fn constraint_first_ad(sys: &System, el: &ConstraintEl, q: &[f64], t: f64, inputs: &[f64]) -> ConstraintFirst {
-    let nq = nql(sys, &el.bodies);
-    let mut r = ConstraintFirst { c: vec![0.0; el.neq], cq: vec![0.0; el.neq * nq], ct: vec![0.0; el.neq] };
-    by_width!(nq + 1, first_k, [1, 7, 13, 19, 25, 31, 37](sys, el, q, t, inputs, &mut r));
+    let mut r = ConstraintFirst::default();
+    r.reset(el.neq, nql(sys, &el.bodies));
+    first_ad(sys, el, q, t, inputs, &mut r);
     r
+}
+
+/// [`constraint_first_ad`] into `r` (zeroed, of the element's size).
+fn first_ad(sys: &System, el: &ConstraintEl, q: &[f64], t: f64, inputs: &[f64], r: &mut ConstraintFirst) {
+    let nq = nql(sys, &el.bodies);
+    by_width!(nq + 1, first_k, [1, 7, 13, 19, 25, 31, 37](sys, el, q, t, inputs, r));
 }
 
 /// The columns `chunk` of z = (local q, t) of [`constraint_first`].
@@ -345,12 +380,16 @@ pub fn dhtw_dq(q: &[f64], w: &[f64]) -> [f64; 36] {
     std::array::from_fn(|i| r[i / 6].d[i % 6])
 }
 
-/// Gyroscopic generalized force −ω'×(Jω') of one body and its 3×3 Jacobian in ω'.
+/// Gyroscopic generalized force −ω'×(Jω') of one body (inertia `j`, body axes).
+pub fn gyroscopic_force<T: Real>(j: &[[f64; 3]; 3], w: &V3<T>) -> V3<T> {
+    let jw = M3::cst(j).mv(w);
+    -w.cross(&jw)
+}
+
+/// [`gyroscopic_force`] and its 3×3 Jacobian in ω'.
 pub fn gyroscopic(j: &[[f64; 3]; 3], w: &[f64]) -> ([f64; 3], [f64; 9]) {
-    use crate::geom::{M3, V3};
     let wd = V3([Dual::<f64, 3>::var(w[0], 0), Dual::var(w[1], 1), Dual::var(w[2], 2)]);
-    let jw = M3::cst(j).mv(&wd);
-    let g = -wd.cross(&jw);
+    let g = gyroscopic_force(j, &wd);
     (g.val(), std::array::from_fn(|i| g.0[i / 3].d[i % 3]))
 }
 

@@ -25,11 +25,16 @@ pub fn body_mass_entries(sys: &System, b: usize, q: &[f64]) -> Vec<(usize, usize
         }
         return out;
     }
+    rigid_mass_entries(sys, b).collect()
+}
+
+/// The entries of [`body_mass_entries`] for rigid body `b`.
+fn rigid_mass_entries(sys: &System, b: usize) -> impl Iterator<Item = (usize, usize, f64)> {
     let (o, body) = (NQ * b, &sys.bodies[b]);
     let (m, j) = (body.mass, body.inertia);
     let translation = (0..3).map(move |c| (o + c, o + c, m));
     let rotation = (0..9).map(move |k| (o + 3 + k / 3, o + 3 + k % 3, j[k / 3][k % 3]));
-    translation.chain(rotation).collect()
+    translation.chain(rotation)
 }
 
 /// Whether body `b`'s block of M is independent of q (rigid bodies).
@@ -40,14 +45,22 @@ pub fn constant_mass(sys: &System, b: usize) -> bool {
 /// M_b a for body `b` at q (a: the body's accelerations, in the order of
 /// [`System::body_dofs`]: [v̇; ω̇'] then η̈).
 pub fn body_mass_times(sys: &System, b: usize, q: &[f64], a: &[f64]) -> Vec<f64> {
+    let mut out = Vec::new();
+    body_mass_times_into(sys, b, q, a, &mut out);
+    out
+}
+
+/// [`body_mass_times`] into `out` (its capacity reused; a flexible body's allocates).
+pub fn body_mass_times_into(sys: &System, b: usize, q: &[f64], a: &[f64], out: &mut Vec<f64>) {
     if let Some(f) = sys.flex_of(b) {
-        return flexible::body_mass_times(&f.inv, &sys.r0[b], &gather(sys, &[b], q), a);
+        *out = flexible::body_mass_times(&f.inv, &sys.r0[b], &gather(sys, &[b], q), a);
+        return;
     }
-    let mut out = vec![0.0; NQ];
-    for (r, c, v) in body_mass_entries(sys, b, q) {
+    out.clear();
+    out.resize(NQ, 0.0);
+    for (r, c, v) in rigid_mass_entries(sys, b) {
         out[r - NQ * b] += v * a[c - NQ * b];
     }
-    out
 }
 
 /// Kinetic energy ½ uᵀ M u of body `b` at (q, u) (global vectors).

@@ -183,7 +183,12 @@ impl System {
 
     /// The global velocity indices of body `b`: its six, then its modal ones.
     pub fn body_dofs(&self, b: usize) -> Vec<usize> {
-        (NQ * b..NQ * b + NQ).chain(self.modal_range(b)).collect()
+        self.body_dofs_iter(b).collect()
+    }
+
+    /// [`System::body_dofs`] as an iterator (nothing allocated).
+    pub fn body_dofs_iter(&self, b: usize) -> impl Iterator<Item = usize> + use<> {
+        (NQ * b..NQ * b + NQ).chain(self.modal_range(b))
     }
 
     /// The flexible body that body `b` is, if any.

@@ -8,6 +8,7 @@
 //! time, and those chunked derivatives are checked the same way.
 
 use mbfmu::dae::equations::{Layout, jacobian, rhs};
+use mbfmu::dae::residual::RhsScratch;
 use mbfmu::dae::sparse::Triplets;
 use mbfmu::mechanics::System;
 use mbfmu::mechanics::body::NQ;
@@ -218,7 +219,7 @@ fn jacobian_matches_central_differences((sys, lay, y): (System, Layout, Vec<f64>
             let mut ys = y.clone();
             ys[c] += s;
             let mut f = vec![0.0; n];
-            rhs(&sys, lay, t, &ys, &INPUTS, &mut f);
+            rhs(&sys, lay, t, &ys, &INPUTS, &mut RhsScratch::default(), &mut f);
             f
         };
         let (f1, fm1, f2, fm2) = (f_at(h), f_at(-h), f_at(2.0 * h), f_at(-2.0 * h));

@@ -8,7 +8,7 @@ use super::accelerations::accelerations;
 use super::user_unknowns::user_unknowns;
 use crate::dae::jacobian::jacobian;
 use crate::dae::layout::{Layout, Slot};
-use crate::dae::residual::rhs;
+use crate::dae::residual::{RhsScratch, rhs};
 use crate::dae::sparse::{SparseLu, Triplets};
 use crate::mechanics::System;
 use crate::mechanics::constraint_jacobian::{acceleration_rhs, constraint_jacobian};
@@ -141,7 +141,7 @@ fn residual_and_jacobian(
 ) -> (Vec<f64>, Triplets) {
     let lay = ix.lay;
     let mut f = vec![0.0; lay.dim()];
-    rhs(sys, lay, t, y, inputs, &mut f);
+    rhs(sys, lay, t, y, inputs, &mut RhsScratch::default(), &mut f);
     let mut r = vec![0.0; ix.dim()];
     let mut k = Triplets::new();
     // Force balance: M u̇ − f_u = 0; u̇ − a = 0 for the acceleration bodies, whose balance

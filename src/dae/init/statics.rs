@@ -4,7 +4,7 @@
 use super::accelerations::accelerations;
 use crate::dae::jacobian::jacobian;
 use crate::dae::layout::Layout;
-use crate::dae::residual::rhs;
+use crate::dae::residual::{RhsScratch, rhs};
 use crate::dae::sparse::{SparseLu, Triplets};
 use crate::mechanics::System;
 use crate::mechanics::body::row_times_t;
@@ -81,10 +81,10 @@ pub fn static_equilibrium(
     let bt = held_directions(sys, q, t, &ext);
     let sub = Subsystem::of(&lay);
     let dim = sub.rows.len() + bt.len();
-    let mut f = vec![0.0; lay.dim()];
+    let (mut f, mut ws) = (vec![0.0; lay.dim()], RhsScratch::default());
     let scale = 1.0 + sys.bodies.iter().map(|b| b.mass).sum::<f64>() * sys.gravity.iter().map(|g| g.abs()).sum::<f64>();
     for _ in 0..MAX_ITERATIONS {
-        rhs(sys, lay, t, &y, inputs, &mut f);
+        rhs(sys, lay, t, &y, inputs, &mut ws, &mut f);
         let mut r: Vec<f64> = sub.rows.iter().map(|&i| f[i]).collect();
         r.extend(bt.iter().map(|row| row.iter().zip(y.iter().zip(&q0)).map(|(b, (x, x0))| b * (x - x0)).sum::<f64>()));
         let worst = r.iter().fold(0.0f64, |a, v| a.max(v.abs()));
