@@ -6,7 +6,7 @@ use crate::geom::V3;
 use crate::mechanics::System;
 use crate::mechanics::body::{NQ, Turn, body_turns, qdot_with};
 use crate::mechanics::constraint_jacobian::p_row_into;
-use crate::mechanics::coords::{gather, global_column};
+use crate::mechanics::coords::{gather, global_column, local_columns_into};
 use crate::mechanics::flexible;
 use crate::mechanics::kernels::{
     ConstraintFirst, constraint_first_into, force_values, gyroscopic_force, nonholonomic_first, user_residual,
@@ -25,8 +25,9 @@ pub struct RhsScratch {
     turns: Vec<Turn<f64>>,
     /// C, C_q, C_t of one constraint element.
     first: ConstraintFirst,
-    /// One row of P.
+    /// One row of P, and the global columns of its entries.
     p: Vec<f64>,
+    cols: Vec<usize>,
     /// One acceleration body's accelerations a, and M a.
     acc: Vec<f64>,
     ma: Vec<f64>,
@@ -109,10 +110,11 @@ fn nonholonomic_rows(sys: &System, lay: Layout, t: f64, y: &[f64], ext: &[f64], 
 fn constraint_rows(sys: &System, lay: Layout, t: f64, y: &[f64], ws: &mut RhsScratch, f: &mut [f64]) {
     let (q, u) = (&y[lay.q_range()], &y[lay.u_range()]);
     let (nu, nl, nm) = (lay.u(), lay.lam(), lay.mu());
-    let RhsScratch { ext, turns, first, p, .. } = ws;
+    let RhsScratch { ext, turns, first, p, cols, .. } = ws;
     for el in &sys.constraints {
         constraint_first_into(sys, el, q, t, ext, Some(turns), first);
-        let nql = first.cq.len() / el.neq.max(1);
+        local_columns_into(sys, &el.bodies, cols);
+        let nql = cols.len();
         p.resize(nql, 0.0);
         for e in 0..el.neq {
             let row = el.row + e;
@@ -124,8 +126,7 @@ fn constraint_rows(sys: &System, lay: Layout, t: f64, y: &[f64], ws: &mut RhsScr
             let cq = &first.cq[e * nql..(e + 1) * nql];
             p_row_into(&el.bodies, |b| turns[b].h, cq, p);
             let (lam, mu, mut pu) = (y[nl + row], y[nm + row], 0.0);
-            for (a, (&pv, &cv)) in p.iter().zip(cq).enumerate() {
-                let g = global_column(sys, &el.bodies, a);
+            for ((&pv, &cv), &g) in p.iter().zip(cq).zip(cols.iter()) {
                 pu += pv * u[g];
                 f[nu + g] -= pv * lam;
                 f[g] -= cv * mu;

@@ -50,21 +50,23 @@ pub struct Turn<T: Real> {
 
 impl<T: Real> Turn<T> {
     /// The turn of a body with reference frame `r0` at Euler angles `e` = (ψ, θ, φ).
+    /// With R = Rz(ψ)Rx(θ)Rz(φ) and E = ∂Rz/∂ψ at 0 (the cross product with z, last row
+    /// and column zero): ∂R/∂ψ = E R, ∂R/∂φ = R E, ∂R/∂θ written out.
     pub fn of(r0: &[[f64; 3]; 3], e: &[T]) -> Turn<T> {
         let s: [T; 3] = std::array::from_fn(|k| e[k].sin());
         let c: [T; 3] = std::array::from_fn(|k| e[k].cos());
         let ([s1, s2, s3], [c1, c2, c3]) = (s, c);
-        let (r0, o, z) = (M3::cst(r0), T::one(), T::zero());
-        let rz = |s: T, c: T| M3([[c, -s, z], [s, c, z], [z, z, o]]);
-        let drz = |s: T, c: T| M3([[-s, -c, z], [c, -s, z], [z, z, z]]);
-        let rx = M3([[o, z, z], [z, c2, -s2], [z, s2, c2]]);
-        let drx = M3([[z, z, z], [z, -s2, -c2], [z, c2, -s2]]);
-        let da = [
-            r0.mm(&drz(s1, c1)).mm(&rx).mm(&rz(s3, c3)),
-            r0.mm(&rz(s1, c1)).mm(&drx).mm(&rz(s3, c3)),
-            r0.mm(&rz(s1, c1)).mm(&rx).mm(&drz(s3, c3)),
-        ];
-        Turn { a: r0.mm(&rot313_sc(s, c)), da, h: h_angular_sc(s2, c2, s3, c3) }
+        let (r, z) = (rot313_sc(s, c), T::zero());
+        let m = &r.0;
+        let d_psi = M3([[-m[1][0], -m[1][1], -m[1][2]], m[0], [z; 3]]);
+        let d_theta = M3([
+            [s1 * s2 * s3, s1 * s2 * c3, s1 * c2],
+            [-(c1 * s2 * s3), -(c1 * s2 * c3), -(c1 * c2)],
+            [c2 * s3, c2 * c3, -s2],
+        ]);
+        let d_phi = M3(std::array::from_fn(|i| [m[i][1], -m[i][0], z]));
+        let r0 = M3::cst(r0);
+        Turn { a: r0.mm(&r), da: [r0.mm(&d_psi), r0.mm(&d_theta), r0.mm(&d_phi)], h: h_angular_sc(s2, c2, s3, c3) }
     }
 }
 

@@ -21,6 +21,12 @@ pub fn local_columns(sys: &System, bodies: &[usize]) -> Vec<usize> {
     columns(sys, bodies).collect()
 }
 
+/// [`local_columns`] into `out` (its capacity reused).
+pub fn local_columns_into(sys: &System, bodies: &[usize], out: &mut Vec<usize>) {
+    out.clear();
+    out.extend(columns(sys, bodies));
+}
+
 /// The global columns of `bodies`' local coordinates, in local order.
 fn columns<'a>(sys: &'a System, bodies: &'a [usize]) -> impl Iterator<Item = usize> + 'a {
     let rigid = bodies.iter().flat_map(|&b| NQ * b..NQ * b + NQ);

@@ -53,18 +53,19 @@ fn dot<T: Real>(a: &V<T>, b: &V<T>) -> T {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
-/// A marker in ground: position, axes, and what its derivatives need.
+/// A marker in ground: position, axes, and their derivatives by its body's Euler angles.
 struct Frame<T: Real> {
     /// First local column of its body's coordinates (None: ground).
     col: Option<usize>,
     p: V<T>,
     /// Axes in ground (axes[k] = k-th axis).
     axes: [V<T>; 3],
-    /// Offset and axes in body axes.
-    s: V<T>,
+    /// Axes in body axes.
     local_axes: [V<T>; 3],
     /// ∂A/∂(ψ, θ, φ) of its body.
     da: [M3<T>; 3],
+    /// ∂p/∂(ψ, θ, φ): dp[k] = ∂A/∂e_k · s (s: the offset in body axes).
+    dp: [V<T>; 3],
 }
 
 impl<T: Real> Frame<T> {
@@ -84,7 +85,8 @@ impl<T: Real> Frame<T> {
         let local_axes: [V<T>; 3] = std::array::from_fn(|k| std::array::from_fn(|r| T::cst(g.rot[r][k])));
         let s = g.s.map(T::cst);
         let Some(b) = g.body else {
-            return Frame { col: None, p: s, axes: local_axes, s, local_axes, da: [M3([[T::zero(); 3]; 3]); 3] };
+            let zero = [[T::zero(); 3]; 3];
+            return Frame { col: None, p: s, axes: local_axes, local_axes, da: [M3(zero); 3], dp: zero };
         };
         let kb = el.bodies.iter().position(|&x| x == b).expect("a joint's marker body is one of its bodies");
         let qb = qb(kb);
@@ -101,18 +103,23 @@ impl<T: Real> Frame<T> {
             col: Some(NQ * kb),
             p: std::array::from_fn(|c| qb[c] + off[c]),
             axes: std::array::from_fn(|k| mv(&turn.a, &local_axes[k])),
-            s,
             local_axes,
             da: turn.da,
+            dp: std::array::from_fn(|k| mv(&turn.da[k], &s)),
         }
     }
 
-    /// Add `sign` · `w` · ∂(A v)/∂(its body's Euler angles) to the gradient row `g`, for
-    /// a vector `v` in body axes.
-    fn add_turn(&self, g: &mut [T], v: &V<T>, w: &V<T>, sign: f64) {
+    /// ∂(A v)/∂(ψ, θ, φ) for a vector `v` in body axes.
+    fn d(&self, v: &V<T>) -> [V<T>; 3] {
+        std::array::from_fn(|k| mv(&self.da[k], v))
+    }
+
+    /// Add `sign` · `w` · `dv` to the Euler-angle entries of the gradient row `g`, `dv`
+    /// the derivatives of a vector by its body's Euler angles (`dp`, or [`Frame::d`]).
+    fn add_turn(&self, g: &mut [T], dv: &[V<T>; 3], w: &V<T>, sign: f64) {
         if let Some(c) = self.col {
             for k in 0..3 {
-                g[c + 3 + k] += dot(w, &mv(&self.da[k], v)).scale(sign);
+                g[c + 3 + k] += dot(w, &dv[k]).scale(sign);
             }
         }
     }
@@ -123,7 +130,7 @@ impl<T: Real> Frame<T> {
             for k in 0..3 {
                 g[c + k] += w[k].scale(sign);
             }
-            self.add_turn(g, &self.s, w, sign);
+            self.add_turn(g, &self.dp, w, sign);
         }
     }
 }
@@ -155,14 +162,14 @@ fn rows<T: Real>(kind: JointType, fi: &Frame<T>, fj: &Frame<T>, c: &mut [T], cq:
             }
             Row::Axes(a, b) => {
                 c[e] = dot(&fi.axes[a], &fj.axes[b]);
-                fi.add_turn(g, &fi.local_axes[a], &fj.axes[b], 1.0);
-                fj.add_turn(g, &fj.local_axes[b], &fi.axes[a], 1.0);
+                fi.add_turn(g, &fi.d(&fi.local_axes[a]), &fj.axes[b], 1.0);
+                fj.add_turn(g, &fj.d(&fj.local_axes[b]), &fi.axes[a], 1.0);
             }
             Row::DAxis(b) => {
                 c[e] = dot(&d, &fj.axes[b]);
                 fi.add_point(g, &fj.axes[b], 1.0);
                 fj.add_point(g, &fj.axes[b], -1.0);
-                fj.add_turn(g, &fj.local_axes[b], &d, 1.0);
+                fj.add_turn(g, &fj.d(&fj.local_axes[b]), &d, 1.0);
             }
         }
     }
