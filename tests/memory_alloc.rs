@@ -14,6 +14,10 @@
 //! nextest runs each in its own process anyway). The warm-up and the measured cycles run
 //! each on a thread of their own, as a host's threads come and go.
 //!
+//! The residual f(t, y) that the integrator evaluates ~7 times per step allocates nothing
+//! once its buffers have grown (models of rigid bodies and joints): counted per thread,
+//! so nothing else running meanwhile can spoil the count.
+//!
 //! A test crate of its own, not a module of tests/it: the counts see the whole process,
 //! and `cargo test` runs the tests of one crate as threads of one process, where any other
 //! test allocating meanwhile would be counted (nextest's process per test would hide
@@ -21,12 +25,15 @@
 
 #![cfg(target_os = "linux")]
 
+use mbfmu::dae::equations::{Layout as DaeLayout, RhsScratch, rhs};
+use mbfmu::dae::{SimOptions, Simulator};
 use mbfmu::fmi::exports_common::*;
 use mbfmu::fmi::exports_cs::fmi2DoStep;
 use mbfmu::fmi::exports_state::*;
 use mbfmu::fmi::guid::guid;
 use mbfmu::fmi::types::{CO_SIMULATION, Component, FmuStatePtr, Status};
 use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
 use std::ffi::CString;
 use std::path::PathBuf;
 use std::sync::Mutex;
@@ -50,9 +57,21 @@ static ALLOCATIONS: AtomicU64 = AtomicU64::new(0);
 /// Bytes asked for by those allocations.
 static ALLOCATED: AtomicU64 = AtomicU64::new(0);
 
+thread_local! {
+    /// Allocations made by this thread (no destructor, const-initialized: readable from
+    /// inside the allocator at any time without allocating).
+    static THREAD_ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
+}
+
 fn counted(bytes: usize) {
     ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
     ALLOCATED.fetch_add(bytes as u64, Ordering::Relaxed);
+    let _ = THREAD_ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+}
+
+/// Allocations made by the calling thread so far.
+fn thread_allocations() -> u64 {
+    THREAD_ALLOCATIONS.with(Cell::get)
 }
 
 // SAFETY: every call is forwarded to the system allocator with its arguments unchanged;
@@ -298,4 +317,30 @@ fn the_measure_sees_a_leak_of_one_byte_per_cycle_and_a_cycle_doing_its_work_twic
         "two instantiate/free per cycle: {:.1} allocations, not above the bound {ALLOCATIONS_PER_INSTANTIATE_BOUND}",
         g.allocations_per_cycle
     );
+}
+
+#[test]
+fn the_residual_of_rigid_bodies_and_joints_allocates_nothing_after_the_first_call() {
+    let _one = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    // The counter sees this thread's allocations (the control).
+    let before = thread_allocations();
+    std::hint::black_box(vec![1u8; 8]);
+    assert_eq!(thread_allocations() - before, 1, "the per-thread count missed an allocation");
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    // Chains and a closed loop (redundant rows) of revolute and spherical joints.
+    for name in ["pendulum", "double_pendulum", "fourbar", "spinning_top"] {
+        let model = mbfmu::model::parse::load_file(&root.join(format!("models/{name}.xml"))).unwrap();
+        let sim = Simulator::new(&model, SimOptions::default(), 0.0).unwrap();
+        let (sys, y, inputs) = (sim.system(), sim.snapshot().y, sim.inputs());
+        let lay = DaeLayout::of(sys);
+        let (mut f, mut ws) = (vec![0.0; y.len()], RhsScratch::default());
+        rhs(sys, lay, 0.0, &y, &inputs, &mut ws, &mut f);
+        let before = thread_allocations();
+        for k in 1..=100 {
+            rhs(sys, lay, 1e-3 * k as f64, &y, &inputs, &mut ws, &mut f);
+        }
+        let made = thread_allocations() - before;
+        assert_eq!(made, 0, "{name}: 100 calls of f(t, y) after the first allocated {made} times");
+        assert!(f.iter().all(|v| v.is_finite()));
+    }
 }
