@@ -344,3 +344,38 @@ fn the_residual_of_rigid_bodies_and_joints_allocates_nothing_after_the_first_cal
         assert!(f.iter().all(|v| v.is_finite()));
     }
 }
+
+/// Allocations per 1 ms `fmi2DoStep` of the pendulum FMU at most, after a warm-up of 0.2 s.
+/// Measured: 11.6 (2026-12-04; 1.5 times that is the bound). What still allocates per step is listed in issue 26's
+/// note (the Jacobian when it is refreshed, the inputs at an accepted step, the outputs);
+/// the bound keeps that from growing until it reaches 0.
+const ALLOCATIONS_PER_DO_STEP_BOUND: f64 = 18.0;
+
+#[test]
+fn a_one_millisecond_do_step_allocates_a_bounded_amount_after_warm_up() {
+    let _one = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    let fmu = Fmu::new("do step");
+    let c = fmu.instantiate();
+    let h = 1e-3;
+    // SAFETY: a live instance, freed once at the end.
+    unsafe {
+        assert_eq!(fmi2SetupExperiment(c, 1, 1e-4, 0.0, 0, 0.0), Status::Ok);
+        assert_eq!(fmi2EnterInitializationMode(c), Status::Ok);
+        assert_eq!(fmi2ExitInitializationMode(c), Status::Ok);
+    }
+    let step = |k: usize| {
+        // SAFETY: a live instance.
+        assert_eq!(unsafe { fmi2DoStep(c, k as f64 * h, h, 1) }, Status::Ok);
+    };
+    (0..200).for_each(step);
+    let before = thread_allocations();
+    (200..1200).for_each(step);
+    let per_step = (thread_allocations() - before) as f64 / 1000.0;
+    println!("{per_step} allocations per 1 ms doStep");
+    // SAFETY: the live instance, freed once.
+    unsafe { fmi2FreeInstance(c) };
+    assert!(
+        per_step <= ALLOCATIONS_PER_DO_STEP_BOUND,
+        "{per_step} allocations per doStep (bound {ALLOCATIONS_PER_DO_STEP_BOUND})"
+    );
+}
