@@ -346,9 +346,10 @@ fn the_residual_of_rigid_bodies_and_joints_allocates_nothing_after_the_first_cal
 }
 
 /// Allocations per 1 ms `fmi2DoStep` of the pendulum FMU at most, after a warm-up of 0.2 s.
-/// Measured: 11.6 (2026-12-04; 1.5 times that is the bound). What still allocates per step is listed in issue 26's
-/// note (the Jacobian when it is refreshed, the inputs at an accepted step, the outputs);
-/// the bound keeps that from growing until it reaches 0.
+/// Measured: 11.6 (2026-12-04; 1.5 times that is the bound). f(t, y) itself allocates
+/// nothing (the test above); what does per step is not itemized yet (the angle-branch
+/// recording at accepted steps builds a dual-number context, the outputs, a refreshed
+/// Jacobian). The bound keeps that from growing until it reaches 0.
 const ALLOCATIONS_PER_DO_STEP_BOUND: f64 = 18.0;
 
 #[test]
