@@ -15,10 +15,8 @@ use super::coords::{gather, nql};
 use super::system::System;
 use crate::ad::chunked::seed;
 use crate::ad::{Dual, Real};
-use crate::geom::M3;
+use crate::geom::{M3, V3};
 use crate::model::JointType;
-
-type V<T> = [T; 3];
 
 /// One equation of a joint, over the marker frames i and j and d = p_i − p_j.
 #[derive(Clone, Copy)]
@@ -45,27 +43,19 @@ fn equations(kind: JointType) -> &'static [Row] {
     }
 }
 
-fn mv<T: Real>(m: &M3<T>, v: &V<T>) -> V<T> {
-    std::array::from_fn(|r| m.0[r][0] * v[0] + m.0[r][1] * v[1] + m.0[r][2] * v[2])
-}
-
-fn dot<T: Real>(a: &V<T>, b: &V<T>) -> T {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
 /// A marker in ground: position, axes, and their derivatives by its body's Euler angles.
 struct Frame<T: Real> {
     /// First local column of its body's coordinates (None: ground).
     col: Option<usize>,
-    p: V<T>,
+    p: V3<T>,
     /// Axes in ground (axes[k] = k-th axis).
-    axes: [V<T>; 3],
+    axes: [V3<T>; 3],
     /// Axes in body axes.
-    local_axes: [V<T>; 3],
+    local_axes: [V3<T>; 3],
     /// ∂A/∂(ψ, θ, φ) of its body.
     da: [M3<T>; 3],
     /// ∂p/∂(ψ, θ, φ): dp[k] = ∂A/∂e_k · s (s: the offset in body axes).
-    dp: [V<T>; 3],
+    dp: [V3<T>; 3],
 }
 
 impl<T: Real> Frame<T> {
@@ -82,11 +72,11 @@ impl<T: Real> Frame<T> {
         T: 'q,
     {
         let g = &sys.markers[m];
-        let local_axes: [V<T>; 3] = std::array::from_fn(|k| std::array::from_fn(|r| T::cst(g.rot[r][k])));
-        let s = g.s.map(T::cst);
+        let local_axes: [V3<T>; 3] = std::array::from_fn(|k| V3(std::array::from_fn(|r| T::cst(g.rot[r][k]))));
+        let s = V3(g.s.map(T::cst));
         let Some(b) = g.body else {
-            let zero = [[T::zero(); 3]; 3];
-            return Frame { col: None, p: s, axes: local_axes, local_axes, da: [M3(zero); 3], dp: zero };
+            let zero = [V3([T::zero(); 3]); 3];
+            return Frame { col: None, p: s, axes: local_axes, local_axes, da: [M3([[T::zero(); 3]; 3]); 3], dp: zero };
         };
         let kb = el.bodies.iter().position(|&x| x == b).expect("a joint's marker body is one of its bodies");
         let qb = qb(kb);
@@ -98,37 +88,36 @@ impl<T: Real> Frame<T> {
                 &own
             }
         };
-        let off = mv(&turn.a, &s);
         Frame {
             col: Some(NQ * kb),
-            p: std::array::from_fn(|c| qb[c] + off[c]),
-            axes: std::array::from_fn(|k| mv(&turn.a, &local_axes[k])),
+            p: V3([qb[0], qb[1], qb[2]]) + turn.a.mv(&s),
+            axes: std::array::from_fn(|k| turn.a.mv(&local_axes[k])),
             local_axes,
             da: turn.da,
-            dp: std::array::from_fn(|k| mv(&turn.da[k], &s)),
+            dp: std::array::from_fn(|k| turn.da[k].mv(&s)),
         }
     }
 
     /// ∂(A v)/∂(ψ, θ, φ) for a vector `v` in body axes.
-    fn d(&self, v: &V<T>) -> [V<T>; 3] {
-        std::array::from_fn(|k| mv(&self.da[k], v))
+    fn d(&self, v: &V3<T>) -> [V3<T>; 3] {
+        std::array::from_fn(|k| self.da[k].mv(v))
     }
 
     /// Add `sign` · `w` · `dv` to the Euler-angle entries of the gradient row `g`, `dv`
     /// the derivatives of a vector by its body's Euler angles (`dp`, or [`Frame::d`]).
-    fn add_turn(&self, g: &mut [T], dv: &[V<T>; 3], w: &V<T>, sign: f64) {
+    fn add_turn(&self, g: &mut [T], dv: &[V3<T>; 3], w: &V3<T>, sign: f64) {
         if let Some(c) = self.col {
             for k in 0..3 {
-                g[c + 3 + k] += dot(w, &dv[k]).scale(sign);
+                g[c + 3 + k] += w.dot(&dv[k]).scale(sign);
             }
         }
     }
 
     /// Add `sign` · `w` · ∂p/∂(its body's coordinates) to the gradient row `g`.
-    fn add_point(&self, g: &mut [T], w: &V<T>, sign: f64) {
+    fn add_point(&self, g: &mut [T], w: &V3<T>, sign: f64) {
         if let Some(c) = self.col {
             for k in 0..3 {
-                g[c + k] += w[k].scale(sign);
+                g[c + k] += w.0[k].scale(sign);
             }
             self.add_turn(g, &self.dp, w, sign);
         }
@@ -150,23 +139,23 @@ fn rows<T: Real>(kind: JointType, fi: &Frame<T>, fj: &Frame<T>, c: &mut [T], cq:
     let eqs = equations(kind);
     let nq = cq.len() / eqs.len();
     cq.fill(T::zero());
-    let d: V<T> = std::array::from_fn(|k| fi.p[k] - fj.p[k]);
+    let d = fi.p - fj.p;
     for (e, eq) in eqs.iter().enumerate() {
         let g = &mut cq[e * nq..(e + 1) * nq];
         match *eq {
             Row::D(k) => {
-                let unit: V<T> = std::array::from_fn(|r| if r == k { T::one() } else { T::zero() });
-                c[e] = d[k];
+                let unit = V3(std::array::from_fn(|r| if r == k { T::one() } else { T::zero() }));
+                c[e] = d.0[k];
                 fi.add_point(g, &unit, 1.0);
                 fj.add_point(g, &unit, -1.0);
             }
             Row::Axes(a, b) => {
-                c[e] = dot(&fi.axes[a], &fj.axes[b]);
+                c[e] = fi.axes[a].dot(&fj.axes[b]);
                 fi.add_turn(g, &fi.d(&fi.local_axes[a]), &fj.axes[b], 1.0);
                 fj.add_turn(g, &fj.d(&fj.local_axes[b]), &fi.axes[a], 1.0);
             }
             Row::DAxis(b) => {
-                c[e] = dot(&d, &fj.axes[b]);
+                c[e] = d.dot(&fj.axes[b]);
                 fi.add_point(g, &fj.axes[b], 1.0);
                 fj.add_point(g, &fj.axes[b], -1.0);
                 fj.add_turn(g, &fj.d(&fj.local_axes[b]), &d, 1.0);
@@ -177,7 +166,9 @@ fn rows<T: Real>(kind: JointType, fi: &Frame<T>, fj: &Frame<T>, c: &mut [T], cq:
 
 /// C and C_q (local, row-major neq × nq; C_t is zero: a joint does not depend on time)
 /// of `el` when it is a joint whose markers are on rigid bodies or ground; None
-/// otherwise, for the general kernel.
+/// otherwise, for the general kernel. The integrator calls [`joint_first_into`]; this
+/// form serves the test that holds the closed form to the dual-number kernels.
+#[cfg(test)]
 pub fn joint_first(sys: &System, el: &ConstraintEl, q: &[f64]) -> Option<(Vec<f64>, Vec<f64>)> {
     rigid_joint(sys, el)?;
     let (mut c, mut cq) = (vec![0.0; el.neq], vec![0.0; el.neq * nql(sys, &el.bodies)]);
