@@ -2,7 +2,7 @@
 //! constraint residuals, state names and values.
 
 use super::error::EngineError;
-use super::simulator::Simulator;
+use super::simulator::{ObserveScratch, Simulator};
 use crate::geom::V3;
 use crate::mechanics::body::{NQ, body_frame};
 use crate::mechanics::loads::{load_index, load_value};
@@ -32,13 +32,26 @@ impl Simulator {
 
     /// Values of the `<output>`s at the current time.
     pub fn outputs(&mut self) -> Result<Vec<f64>, EngineError> {
+        let mut out = Vec::new();
+        self.outputs_into(&mut out)?;
+        Ok(out)
+    }
+
+    /// [`Simulator::outputs`] into `out` (its capacity reused: when no output reads
+    /// accelerations, loads or user unknowns, nothing is allocated once warm).
+    pub fn outputs_into(&mut self, out: &mut Vec<f64>) -> Result<(), EngineError> {
+        out.clear();
         if !self.outputs_need_acc && self.acc.is_none() {
             // Positions and velocities only: no acceleration solve.
-            let sys = &self.dae.sys;
-            let ids: Vec<usize> = (0..sys.nb()).collect();
-            let inputs = self.ext();
-            let ctx = LocalCtx::new(sys, &ids, self.q(), self.u(), &[], self.radau.t, &inputs);
-            return Ok(sys.outputs.iter().zip(&sys.output_bases).map(|(e, &b)| ctx.eval_expr(e, b)).collect());
+            let (t, lay, sys) = (self.radau.t, self.dae.lay, &self.dae.sys);
+            let ObserveScratch { ids, inputs, ext } = &mut self.obs;
+            ids.clear();
+            ids.extend(0..sys.nb());
+            self.dae.inputs_into(t, inputs);
+            lay.ext_into(sys, inputs, &self.radau.y, t, ext);
+            let ctx = LocalCtx::new(sys, ids, &self.radau.y[lay.q_range()], &self.radau.y[lay.u_range()], &[], t, ext);
+            out.extend(sys.outputs.iter().zip(&sys.output_bases).map(|(e, &b)| ctx.eval_expr(e, b)));
+            return Ok(());
         }
         let (udot, lam) = self.accelerations()?;
         let sys = &self.dae.sys;
@@ -47,7 +60,8 @@ impl Simulator {
         let inputs = self.ext_with(&lam);
         let mut ctx = LocalCtx::new(sys, &ids, self.q(), self.u(), &udot, self.radau.t, &inputs);
         ctx.loads = Some(&ctx_loads);
-        Ok(sys.outputs.iter().zip(&sys.output_bases).map(|(e, &b)| ctx.eval_expr(e, b)).collect())
+        out.extend(sys.outputs.iter().zip(&sys.output_bases).map(|(e, &b)| ctx.eval_expr(e, b)));
+        Ok(())
     }
 
     /// Component `f` of the load element `e` applies on its i marker (NaN if it has none),

@@ -7,6 +7,7 @@ use super::radau::DaeProblem;
 use super::residual::RhsScratch;
 use super::sparse::Triplets;
 use crate::mechanics::System;
+use crate::mechanics::angles::AngleScratch;
 
 /// The multibody DAE handed to the integrator.
 pub(super) struct MultibodyDae {
@@ -21,6 +22,11 @@ pub(super) struct MultibodyDae {
     /// The inputs at the time of the last [`DaeProblem::rhs`], and that function's buffers.
     inputs_now: Vec<f64>,
     ws: RhsScratch,
+    /// Buffers of the angle-branch recording at accepted steps: the inputs, the external
+    /// values and the recording's own.
+    accepted_inputs: Vec<f64>,
+    accepted_ext: Vec<f64>,
+    angles: AngleScratch,
 }
 
 impl DaeProblem for MultibodyDae {
@@ -48,8 +54,9 @@ impl DaeProblem for MultibodyDae {
     fn accepted(&mut self, t: f64, y: &mut [f64]) -> bool {
         let (qs, us) = (self.lay.q_range(), self.lay.u_range());
         let changed = self.sys.rebase_frames(&mut y[qs.clone()]);
-        let ext = self.lay.ext(&self.sys, &self.inputs_at(t), y, t);
-        self.sys.record_angles(t, &y[qs], &y[us], &ext);
+        interpolate(&self.inputs, &self.slopes, t - self.t_in, &mut self.accepted_inputs);
+        self.lay.ext_into(&self.sys, &self.accepted_inputs, y, t, &mut self.accepted_ext);
+        self.sys.record_angles_with(&mut self.angles, t, &y[qs], &y[us], &self.accepted_ext);
         changed
     }
 }
@@ -58,14 +65,30 @@ impl MultibodyDae {
     /// The DAE of `sys` (laid out by `lay`) with inputs `inputs` at `t_in`, changing at
     /// `slopes`.
     pub(super) fn new(sys: System, lay: Layout, inputs: Vec<f64>, slopes: Vec<f64>, t_in: f64) -> MultibodyDae {
-        MultibodyDae { sys, lay, inputs, slopes, t_in, inputs_now: Vec::new(), ws: RhsScratch::default() }
+        MultibodyDae {
+            sys,
+            lay,
+            inputs,
+            slopes,
+            t_in,
+            inputs_now: Vec::new(),
+            ws: RhsScratch::default(),
+            accepted_inputs: Vec::new(),
+            accepted_ext: Vec::new(),
+            angles: AngleScratch::default(),
+        }
     }
 
     /// Inputs at time t: held values plus slope · (t − t_in).
     pub(super) fn inputs_at(&self, t: f64) -> Vec<f64> {
         let mut v = Vec::new();
-        interpolate(&self.inputs, &self.slopes, t - self.t_in, &mut v);
+        self.inputs_into(t, &mut v);
         v
+    }
+
+    /// [`MultibodyDae::inputs_at`] into `v` (its capacity reused).
+    pub(super) fn inputs_into(&self, t: f64, v: &mut Vec<f64>) {
+        interpolate(&self.inputs, &self.slopes, t - self.t_in, v);
     }
 }
 

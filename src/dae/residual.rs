@@ -9,7 +9,8 @@ use crate::mechanics::constraint_jacobian::p_row_into;
 use crate::mechanics::coords::{gather, global_column, local_columns_into};
 use crate::mechanics::flexible;
 use crate::mechanics::kernels::{
-    ConstraintFirst, constraint_first_into, force_values, gyroscopic_force, nonholonomic_first, user_residual,
+    ConstraintFirst, Gathered, constraint_first_into, force_values_into, gyroscopic_force, nonholonomic_first,
+    user_residual_with,
 };
 use crate::mechanics::mass::body_mass_times_into;
 
@@ -31,10 +32,29 @@ pub struct RhsScratch {
     /// One acceleration body's accelerations a, and M a.
     acc: Vec<f64>,
     ma: Vec<f64>,
+    /// One element's local q and u, and its generalized forces.
+    gathered: Gathered,
+    forces: Vec<f64>,
 }
 
 /// Applied generalized forces Q(u, q, t): gravity, gyroscopic terms and force elements.
 pub fn applied_forces(sys: &System, q: &[f64], u: &[f64], t: f64, inputs: &[f64], out: &mut [f64]) {
+    applied_forces_with(sys, q, u, t, inputs, &mut Gathered::default(), &mut Vec::new(), out);
+}
+
+/// [`applied_forces`] with reused buffers: `g` for an element's local coordinates,
+/// `v` for its generalized forces.
+#[allow(clippy::too_many_arguments)]
+fn applied_forces_with(
+    sys: &System,
+    q: &[f64],
+    u: &[f64],
+    t: f64,
+    inputs: &[f64],
+    g: &mut Gathered,
+    v: &mut Vec<f64>,
+    out: &mut [f64],
+) {
     for (b, body) in sys.bodies.iter().enumerate() {
         if let Some(fb) = sys.flex_of(b) {
             // Gravity, quadratic-velocity, elastic and damping forces of a flexible body.
@@ -53,7 +73,7 @@ pub fn applied_forces(sys: &System, q: &[f64], u: &[f64], t: f64, inputs: &[f64]
         out[o + 3..o + 6].copy_from_slice(&g.0);
     }
     for el in &sys.forces {
-        let v = force_values(sys, el, q, u, t, inputs);
+        force_values_into(sys, el, q, u, t, inputs, g, v);
         for (a, x) in v.iter().enumerate() {
             out[global_column(sys, &el.bodies, a)] += x;
         }
@@ -65,26 +85,26 @@ pub fn rhs(sys: &System, lay: Layout, t: f64, y: &[f64], inputs: &[f64], ws: &mu
     let (q, u) = (&y[lay.q_range()], &y[lay.u_range()]);
     lay.ext_into(sys, inputs, y, t, &mut ws.ext);
     body_turns(&sys.r0, q, &mut ws.turns);
-    user_rows(sys, lay, t, y, &ws.ext, f);
+    user_rows(sys, lay, t, y, &ws.ext, &mut ws.gathered, f);
     for (b, turn) in ws.turns.iter().enumerate() {
         let o = NQ * b;
         f[o..o + NQ].copy_from_slice(&qdot_with(&turn.h, &u[o..o + NQ])); // Eq. 13b
     }
     let modal = sys.modal_columns();
     f[modal.clone()].copy_from_slice(&u[modal]); // η̇ = u_η
-    applied_forces(sys, q, u, t, &ws.ext, &mut f[lay.u_range()]);
+    applied_forces_with(sys, q, u, t, &ws.ext, &mut ws.gathered, &mut ws.forces, &mut f[lay.u_range()]);
     nonholonomic_rows(sys, lay, t, y, &ws.ext, f);
     constraint_rows(sys, lay, t, y, ws, f);
     acceleration_rows(sys, lay, y, ws, f);
 }
 
 /// X' = Ẋ, and the user rows r(q, u, Z, v, t) (Eq. 7a–7b).
-fn user_rows(sys: &System, lay: Layout, t: f64, y: &[f64], ext: &[f64], f: &mut [f64]) {
+fn user_rows(sys: &System, lay: Layout, t: f64, y: &[f64], ext: &[f64], g: &mut Gathered, f: &mut [f64]) {
     let (q, u) = (&y[lay.q_range()], &y[lay.u_range()]);
     f[lay.x_range()].copy_from_slice(&y[lay.xdot_range()]);
     let r0 = lay.z_alg_range().start;
     for (k, ue) in sys.user.iter().enumerate() {
-        f[r0 + k] = user_residual(sys, ue, q, u, t, ext);
+        f[r0 + k] = user_residual_with(sys, ue, q, u, t, ext, g);
     }
 }
 

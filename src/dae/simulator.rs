@@ -27,6 +27,17 @@ pub struct Simulator {
     /// Whether an output reads accelerations, loads (λ) or user unknowns: only then do
     /// outputs need the acceleration solve (a KKT factorization per communication point).
     pub(super) outputs_need_acc: bool,
+    /// Buffers of the outputs' evaluation (every body's index, the inputs, the external
+    /// values): reading outputs at each communication point allocates nothing.
+    pub(super) obs: ObserveScratch,
+}
+
+/// Buffers of [`Simulator::outputs_into`].
+#[derive(Debug, Default)]
+pub(super) struct ObserveScratch {
+    pub(super) ids: Vec<usize>,
+    pub(super) inputs: Vec<f64>,
+    pub(super) ext: Vec<f64>,
 }
 
 impl Simulator {
@@ -89,7 +100,15 @@ impl Simulator {
             let d = crate::model::expr::deps(e);
             d.level >= 2 || !d.loads.is_empty() || !d.variables.is_empty() || !d.diff_dots.is_empty()
         });
-        Ok(Simulator { dae, radau, acc_lu, acc: Some((udot, lam)), warnings, outputs_need_acc })
+        Ok(Simulator {
+            dae,
+            radau,
+            acc_lu,
+            acc: Some((udot, lam)),
+            warnings,
+            outputs_need_acc,
+            obs: ObserveScratch::default(),
+        })
     }
 
     /// Current time.
@@ -195,6 +214,11 @@ impl Simulator {
     /// Current input values.
     pub fn inputs(&self) -> Vec<f64> {
         self.dae.inputs_at(self.radau.t)
+    }
+
+    /// Input `i` at the current time (as [`Simulator::inputs`], without a vector).
+    pub fn input(&self, i: usize) -> f64 {
+        self.dae.inputs[i] + self.dae.slopes[i] * (self.radau.t - self.dae.t_in)
     }
 
     /// Current slope of input `i` (0 unless set by [`Simulator::set_input_derivative`]).

@@ -64,6 +64,8 @@ pub struct Instance {
     /// Start values the host set on states before initialization ended: (value reference,
     /// value), each state once, in the order first set; met exactly by initialization.
     pub starts: Vec<(u32, f64)>,
+    /// The outputs' values while fmi2GetReal reads them (kept: nothing is allocated).
+    outputs: Vec<f64>,
 }
 
 impl Instance {
@@ -87,6 +89,7 @@ impl Instance {
             last_time,
             states: StateHandles::default(),
             starts: Vec::new(),
+            outputs: Vec::new(),
         }
     }
 
@@ -263,24 +266,27 @@ impl Instance {
 
     /// fmi2GetReal: values of `vrs` into `out`.
     pub fn get_reals(&mut self, vrs: &[u32], out: &mut [f64]) -> Result<(), String> {
-        let targets =
-            vrs.iter().map(|&vr| Ok(self.typed_var(vr, false)?.target)).collect::<Result<Vec<Target>, String>>()?;
-        let mut outputs = None;
-        let mut inputs = None;
+        for &vr in vrs {
+            self.typed_var(vr, false)?;
+        }
+        let mut have_outputs = false;
         let mut states: Option<crate::linearize::StateValues> = None;
-        for (t, o) in targets.iter().zip(out.iter_mut()) {
+        for (&vr, o) in vrs.iter().zip(out.iter_mut()) {
+            let target = self.typed_var(vr, false)?.target;
+            let t = &target;
             *o = match *t {
                 Target::Parameter(k) => self.config.params[k],
-                Target::Input(k) if self.initialized() => {
-                    inputs.get_or_insert_with(|| self.built.as_ref().expect("initialized").sim.inputs())[k]
-                }
+                Target::Input(k) if self.initialized() => self.built.as_ref().expect("initialized").sim.input(k),
                 Target::Input(k) => self.config.inputs[k],
                 Target::Output(k) => {
-                    if outputs.is_none() {
+                    if !have_outputs {
+                        let mut values = std::mem::take(&mut self.outputs);
                         let sim = self.simulator()?;
-                        outputs = Some(sim.outputs().map_err(|e| format!("outputs cannot be evaluated: {e}"))?);
+                        sim.outputs_into(&mut values).map_err(|e| format!("outputs cannot be evaluated: {e}"))?;
+                        self.outputs = values;
+                        have_outputs = true;
                     }
-                    outputs.as_ref().expect("evaluated")[k]
+                    self.outputs[k]
                 }
                 Target::State(k) | Target::StateDerivative(k) | Target::Velocity(k) | Target::VelocityDerivative(k) => {
                     if states.is_none() {

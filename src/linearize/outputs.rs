@@ -74,10 +74,10 @@ pub fn output_gradient(sys: &System, e: &Expr, abase: usize, p: Point) -> Output
         .map(|k| {
             let (ql, ul, al) =
                 (lift(gather(sys, &own, p.q)), lift(gather(sys, &own, p.u)), lift(gather(sys, &own, p.udot)));
+            let loads = |f: LoadFn, r: ElementRef| Dual::cst(value_of(f, r));
             let mut ctx = LocalCtx::new(sys, &own, &ql, &ul, &al, Dual::cst(p.t), p.inputs);
             let seeded = p.inputs.iter().enumerate().map(|(i, &v)| if i == k { Dual::var(v, 0) } else { Dual::cst(v) });
             ctx.input_values = Some(seeded.collect());
-            let loads = |f: LoadFn, r: ElementRef| Dual::cst(value_of(f, r));
             ctx.loads = Some(&loads);
             ctx.eval_expr(e, abase).d[0]
         })
@@ -136,11 +136,11 @@ fn load_sensitivity(
     type D = Dual<f64, NLOAD>;
     let lift = |x: Vec<f64>| -> Vec<D> { x.into_iter().map(D::cst).collect() };
     let (ql, ul, al) = (lift(gather(sys, own, p.q)), lift(gather(sys, own, p.u)), lift(gather(sys, own, p.udot)));
-    let mut ctx = LocalCtx::new(sys, own, &ql, &ul, &al, D::cst(p.t), p.inputs);
     let loads = |f: LoadFn, x: ElementRef| {
         let v = value_of(f, x);
         if x == r { D::var(v, load_index(f)) } else { D::cst(v) }
     };
+    let mut ctx = LocalCtx::new(sys, own, &ql, &ul, &al, D::cst(p.t), p.inputs);
     ctx.loads = Some(&loads);
     ctx.eval_expr(e, abase).d
 }
@@ -197,8 +197,8 @@ fn grad_k<const K: usize>(
     };
     let (ql, ul, al) =
         (seed(gather(sys, own, p.q), 0), seed(gather(sys, own, p.u), nc), seed(gather(sys, own, p.udot), 2 * nc));
-    let mut ctx = LocalCtx::new(sys, own, &ql, &ul, &al, Dual::cst(p.t), p.inputs);
     let loads = |f: LoadFn, r: ElementRef| Dual::cst(value_of(f, r));
+    let mut ctx = LocalCtx::new(sys, own, &ql, &ul, &al, Dual::cst(p.t), p.inputs);
     ctx.loads = Some(&loads);
     ctx.eval_expr(e, abase).d[..3 * nc].to_vec()
 }

@@ -5,8 +5,8 @@
 //! own branches (`ForceEl::angle_ref`) are recorded with the rest.
 
 use super::body::{FAR_FROM_SINGULAR, NQ, rebased_reference};
-use super::coords::{gather, rates};
-use super::local::LocalCtx;
+use super::coords::{gather_into, rates_into};
+use super::local::{AngleRecord, LocalCtx};
 use super::system::System;
 use crate::ad::{Dual, Real};
 use crate::geom::{M3, rot313};
@@ -40,59 +40,137 @@ impl System {
     /// along the motion (q̇ = H(q) u, ṫ = 1; angle measures depend on positions only);
     /// `ext` holds the external values (a shorter slice reads the rest as NaN).
     pub fn record_angles(&mut self, t: f64, q: &[f64], u: &[f64], ext: &[f64]) {
+        self.record_angles_with(&mut AngleScratch::default(), t, q, u, ext);
+    }
+
+    /// [`System::record_angles`] with reused buffers: once `ws` knows which elements hold
+    /// angle measures (from its first use, with this system), only those are evaluated,
+    /// and nothing is allocated.
+    pub fn record_angles_with(&mut self, ws: &mut AngleScratch, t: f64, q: &[f64], u: &[f64], ext: &[f64]) {
         if self.angle_refs.is_empty() {
             return;
         }
-        let rec = std::cell::RefCell::new(Vec::new());
+        let first = ws.holders.is_none();
+        let mut found = Holders::default();
         {
+            let AngleScratch { holders, ids, qd, ud, rates, out, rec } = ws;
+            let all = Holders::default();
+            let h = holders.as_ref().unwrap_or(&all);
             let sys = &*self;
-            let ids: Vec<usize> = (0..sys.nb()).collect();
-            type D1 = Dual<f64, 1>;
-            let rates = rates(sys.nb(), q, u);
-            let qd: Vec<D1> = q.iter().zip(rates).map(|(&v, d)| D1 { v, d: [d] }).collect();
-            let ud: Vec<D1> = u.iter().map(|&v| D1::cst(v)).collect();
-            let mut ctx = LocalCtx::new(sys, &ids, &qd, &ud, &[], D1 { v: t, d: [1.0] }, ext);
-            ctx.record = Some(&rec);
-            for ue in &sys.user {
-                ue.residual(&ctx);
-            }
-            for el in &sys.constraints {
-                let mut out = vec![D1::zero(); el.neq];
-                el.kind.eval(&ctx, &mut out);
-            }
-            for el in &sys.forces {
-                el.load(&ctx);
-            }
-            for (e, &b) in sys.outputs.iter().zip(&sys.output_bases) {
-                ctx.eval_expr(e, b);
-            }
-            for (_, e, b) in sys.lin_states.iter().chain(&sys.lin_velocities) {
+            ids.clear();
+            ids.extend(0..sys.nb());
+            rates_into(sys.nb(), q, u, rates);
+            qd.clear();
+            qd.extend(q.iter().zip(rates.iter()).map(|(&v, &d)| D1 { v, d: [d] }));
+            ud.clear();
+            ud.extend(u.iter().map(|&v| D1::cst(v)));
+            rec.get_mut().clear();
+            let mut ctx = LocalCtx::new(sys, ids, qd, ud, &[], D1 { v: t, d: [1.0] }, ext);
+            ctx.record = Some(rec);
+            // Evaluate element k of a group when it is a holder (or on the first use);
+            // note it when it recorded something.
+            let visit = |group: &[usize], n: usize, found: &mut Vec<usize>, eval: &mut dyn FnMut(usize)| {
+                let mut each = |k: usize| {
+                    let before = rec.borrow().len();
+                    eval(k);
+                    if first && rec.borrow().len() > before {
+                        found.push(k);
+                    }
+                };
+                if first { (0..n).for_each(&mut each) } else { group.iter().copied().for_each(&mut each) }
+            };
+            visit(&h.users, sys.user.len(), &mut found.users, &mut |k| {
+                sys.user[k].residual(&ctx);
+            });
+            visit(&h.constraints, sys.constraints.len(), &mut found.constraints, &mut |k| {
+                let el = &sys.constraints[k];
+                out.clear();
+                out.resize(el.neq, D1::zero());
+                el.kind.eval(&ctx, out);
+            });
+            visit(&h.forces, sys.forces.len(), &mut found.forces, &mut |k| {
+                sys.forces[k].load(&ctx);
+            });
+            visit(&h.outputs, sys.outputs.len(), &mut found.outputs, &mut |k| {
+                ctx.eval_expr(&sys.outputs[k], sys.output_bases[k]);
+            });
+            let (ns, nv) = (sys.lin_states.len(), sys.lin_velocities.len());
+            visit(&h.lin, ns + nv, &mut found.lin, &mut |k| {
+                let (_, e, b) = if k < ns { &sys.lin_states[k] } else { &sys.lin_velocities[k - ns] };
                 ctx.eval_expr(e, *b);
-            }
-            for c in &sys.joint_coords {
+            });
+            visit(&h.coords, sys.joint_coords.len(), &mut found.coords, &mut |k| {
+                let c = &sys.joint_coords[k];
                 ctx.eval_expr(&c.f, c.abase);
+            });
+            visit(&h.nonholonomic, sys.nonholonomic.len(), &mut found.nonholonomic, &mut |k| {
+                let el = &sys.nonholonomic[k];
+                out.clear();
+                out.resize(el.neq, D1::zero());
+                el.kind.eval(&ctx, out);
+            });
+            drop(ctx);
+            for &(g, v, rate) in rec.get_mut().iter() {
+                // A measure that could not be evaluated (it reads a value not given) keeps its branch.
+                if v.is_finite() {
+                    self.angle_refs[g] = v;
+                    self.angle_rates[g] = if rate.is_finite() { rate } else { 0.0 };
+                }
             }
-            for el in &sys.nonholonomic {
-                let mut out = vec![D1::zero(); el.neq];
-                el.kind.eval(&ctx, &mut out);
-            }
+            self.angle_time = t;
         }
-        for (g, v, rate) in rec.into_inner() {
-            // A measure that could not be evaluated (it reads a value not given) keeps its branch.
-            if v.is_finite() {
-                self.angle_refs[g] = v;
-                self.angle_rates[g] = if rate.is_finite() { rate } else { 0.0 };
-            }
-        }
-        self.angle_time = t;
         // Rotational springs keep their own branch (their unwrapped az).
-        for k in 0..self.forces.len() {
+        let springs = if first {
+            (0..self.forces.len()).collect()
+        } else {
+            std::mem::take(&mut ws.holders.as_mut().expect("known").springs)
+        };
+        for &k in &springs {
             let el = &self.forces[k];
-            let ql = gather(self, &el.bodies, q);
-            let ctx = LocalCtx::new(self, &el.bodies, &ql, &[], &[], t, ext);
-            if let Some(a) = el.angle(&ctx).filter(|a| a.is_finite()) {
+            gather_into(self, &el.bodies, q, &mut ws.rates);
+            let ctx = LocalCtx::new(self, &el.bodies, &ws.rates, &[], &[], t, ext);
+            let a = el.angle(&ctx);
+            drop(ctx);
+            if first && a.is_some() {
+                found.springs.push(k);
+            }
+            if let Some(a) = a.filter(|a| a.is_finite()) {
                 self.forces[k].angle_ref = a;
             }
         }
+        match &mut ws.holders {
+            Some(h) => h.springs = springs,
+            None => ws.holders = Some(found),
+        }
     }
+}
+
+type D1 = Dual<f64, 1>;
+
+/// The elements of each group that hold angle measures, by index.
+#[derive(Clone, Debug, Default)]
+struct Holders {
+    users: Vec<usize>,
+    constraints: Vec<usize>,
+    forces: Vec<usize>,
+    outputs: Vec<usize>,
+    /// Linearization states, then velocities.
+    lin: Vec<usize>,
+    coords: Vec<usize>,
+    nonholonomic: Vec<usize>,
+    /// Rotational springs (their own branch).
+    springs: Vec<usize>,
+}
+
+/// Buffers of [`System::record_angles_with`] for one system, and the elements of it that
+/// hold angle measures.
+#[derive(Debug, Default)]
+pub struct AngleScratch {
+    holders: Option<Holders>,
+    ids: Vec<usize>,
+    qd: Vec<D1>,
+    ud: Vec<D1>,
+    rates: Vec<f64>,
+    out: Vec<D1>,
+    rec: AngleRecord,
 }

@@ -54,6 +54,12 @@ pub fn gather(sys: &System, bodies: &[usize], x: &[f64]) -> Vec<f64> {
     columns(sys, bodies).map(|g| x[g]).collect()
 }
 
+/// [`gather`] into `out` (its capacity reused).
+pub fn gather_into(sys: &System, bodies: &[usize], x: &[f64], out: &mut Vec<f64>) {
+    out.clear();
+    out.extend(columns(sys, bodies).map(|g| x[g]));
+}
+
 /// Where local body `k`'s modal coordinates sit among an element's local coordinates.
 pub fn local_modal_range(sys: &System, bodies: &[usize], k: usize) -> Range<usize> {
     let start = NQ * bodies.len() + bodies[..k].iter().map(|&b| sys.modal_range(b).len()).sum::<usize>();
@@ -64,10 +70,17 @@ pub fn local_modal_range(sys: &System, bodies: &[usize], k: usize) -> Range<usiz
 /// one with `nbodies` bodies: H(q_b) u_b for each body's six, then the modal coordinates'
 /// rates, which are their velocities (H = I there).
 pub fn rates(nbodies: usize, q: &[f64], u: &[f64]) -> Vec<f64> {
-    let mut qd = u.to_vec();
+    let mut qd = Vec::new();
+    rates_into(nbodies, q, u, &mut qd);
+    qd
+}
+
+/// [`rates`] into `qd` (its capacity reused).
+pub fn rates_into(nbodies: usize, q: &[f64], u: &[f64], qd: &mut Vec<f64>) {
+    qd.clear();
+    qd.extend_from_slice(u);
     for b in 0..nbodies {
         let r = NQ * b..NQ * b + NQ;
         qd[r.clone()].copy_from_slice(&qdot(&q[r.clone()], &u[r]));
     }
-    qd
 }

@@ -4,7 +4,7 @@
 
 use super::body::{Turn, h_transpose_times, qdot};
 use super::constraints::ConstraintEl;
-use super::coords::{gather, nql};
+use super::coords::{gather, gather_into, nql};
 use super::forces::ForceEl;
 use super::joint_gradient;
 use super::local::LocalCtx;
@@ -316,11 +316,44 @@ fn nh_second_k<const KQ: usize, const KU: usize>(
 
 /// Generalized forces of one element on its bodies (6 per local body).
 pub fn force_values(sys: &System, el: &ForceEl, q: &[f64], u: &[f64], t: f64, inputs: &[f64]) -> Vec<f64> {
-    let (ql, ul) = (gather(sys, &el.bodies, q), gather(sys, &el.bodies, u));
-    let ctx = LocalCtx::new(sys, &el.bodies, &ql, &ul, &[], t, inputs);
-    let mut out = vec![0.0; nql(sys, &el.bodies)];
-    el.generalized(&ctx, &mut out);
+    let mut out = Vec::new();
+    force_values_into(sys, el, q, u, t, inputs, &mut Gathered::default(), &mut out);
     out
+}
+
+/// An element's local coordinates and velocities, gathered into reused buffers.
+#[derive(Clone, Debug, Default)]
+pub struct Gathered {
+    ql: Vec<f64>,
+    ul: Vec<f64>,
+}
+
+impl Gathered {
+    /// Gather `bodies`' local q and u from the global ones.
+    pub fn of(&mut self, sys: &System, bodies: &[usize], q: &[f64], u: &[f64]) -> (&[f64], &[f64]) {
+        gather_into(sys, bodies, q, &mut self.ql);
+        gather_into(sys, bodies, u, &mut self.ul);
+        (&self.ql, &self.ul)
+    }
+}
+
+/// [`force_values`] into `out`, gathering into `g` (capacities reused).
+#[allow(clippy::too_many_arguments)]
+pub fn force_values_into(
+    sys: &System,
+    el: &ForceEl,
+    q: &[f64],
+    u: &[f64],
+    t: f64,
+    inputs: &[f64],
+    g: &mut Gathered,
+    out: &mut Vec<f64>,
+) {
+    let (ql, ul) = g.of(sys, &el.bodies, q, u);
+    let ctx = LocalCtx::new(sys, &el.bodies, ql, ul, &[], t, inputs);
+    out.clear();
+    out.resize(nql(sys, &el.bodies), 0.0);
+    el.generalized(&ctx, out);
 }
 
 /// Generalized forces and their exact Jacobian: rows 6nb, columns (local q, local u).
@@ -429,8 +462,21 @@ fn seed_ext(ext: &[f64], k: usize) -> Vec<Dual<f64, 1>> {
 
 /// Residual of a user row (Eq. 7a–7b).
 pub fn user_residual(sys: &System, ue: &UserEq, q: &[f64], u: &[f64], t: f64, ext: &[f64]) -> f64 {
-    let (ql, ul) = (gather(sys, &ue.bodies, q), gather(sys, &ue.bodies, u));
-    ue.residual(&LocalCtx::new(sys, &ue.bodies, &ql, &ul, &[], t, ext))
+    user_residual_with(sys, ue, q, u, t, ext, &mut Gathered::default())
+}
+
+/// [`user_residual`], gathering into `g` (capacities reused).
+pub fn user_residual_with(
+    sys: &System,
+    ue: &UserEq,
+    q: &[f64],
+    u: &[f64],
+    t: f64,
+    ext: &[f64],
+    g: &mut Gathered,
+) -> f64 {
+    let (ql, ul) = g.of(sys, &ue.bodies, q, u);
+    ue.residual(&LocalCtx::new(sys, &ue.bodies, ql, ul, &[], t, ext))
 }
 
 /// Exact derivatives of a user row: ∂r/∂(local q, local u) (12nb) and ∂r/∂w for each

@@ -87,24 +87,26 @@ impl<'a, T: Real> LocalCtx<'a, T> {
     /// flexible ones: [`super::coords`]), velocities `u` and accelerations `udot` (same
     /// layout, may be empty = zero).
     pub fn new(sys: &'a System, ids: &'a [usize], q: &[T], u: &[T], udot: &[T], t: T, inputs: &'a [f64]) -> Self {
-        let modal = (0..ids.len())
-            .map(|k| {
-                let r = local_modal_range(sys, ids, k);
-                let part = |x: &[T]| if x.is_empty() { vec![T::zero(); r.len()] } else { x[r.clone()].to_vec() };
-                [q[r.clone()].to_vec(), part(u), part(udot)]
-            })
-            .collect();
-        let bodies = ids
-            .iter()
-            .enumerate()
-            .map(|(k, &b)| {
-                let (r, a) = body_frame(&q[NQ * k..NQ * k + NQ], &sys.r0[b]);
-                let get = |x: &[T], o: usize| {
-                    if x.is_empty() { V3::zero() } else { V3([x[NQ * k + o], x[NQ * k + o + 1], x[NQ * k + o + 2]]) }
-                };
-                LocalBody { r, a, v: get(u, 0), w: get(u, 3), acc: get(udot, 0), wdot: get(udot, 3) }
-            })
-            .collect();
+        let (mut bodies, mut modal) = spare::take::<T>();
+        modal.resize_with(ids.len(), Default::default);
+        for (k, m) in modal.iter_mut().enumerate() {
+            let r = local_modal_range(sys, ids, k);
+            for (part, x) in m.iter_mut().zip([q, u, udot]) {
+                part.clear();
+                if x.is_empty() {
+                    part.resize(r.len(), T::zero());
+                } else {
+                    part.extend_from_slice(&x[r.clone()]);
+                }
+            }
+        }
+        bodies.extend(ids.iter().enumerate().map(|(k, &b)| {
+            let (r, a) = body_frame(&q[NQ * k..NQ * k + NQ], &sys.r0[b]);
+            let get = |x: &[T], o: usize| {
+                if x.is_empty() { V3::zero() } else { V3([x[NQ * k + o], x[NQ * k + o + 1], x[NQ * k + o + 2]]) }
+            };
+            LocalBody { r, a, v: get(u, 0), w: get(u, 3), acc: get(udot, 0), wdot: get(udot, 3) }
+        }));
         LocalCtx {
             sys,
             ids,
@@ -272,5 +274,63 @@ impl<T: Real> ExprEnv<T> for LocalCtx<'_, T> {
             rec.borrow_mut().push((g, out.val(), out.tangent()));
         }
         out
+    }
+}
+
+impl<T: Real> Drop for LocalCtx<'_, T> {
+    fn drop(&mut self) {
+        spare::give(std::mem::take(&mut self.bodies), std::mem::take(&mut self.modal));
+    }
+}
+
+/// The buffers of dropped contexts, per scalar type and thread, for the next ones: once
+/// warm, building a context allocates nothing (the integrator's step loop, the outputs a
+/// co-simulation master reads at every communication point).
+mod spare {
+    use super::LocalBody;
+    use crate::ad::Real;
+    use std::any::{Any, TypeId};
+    use std::cell::RefCell;
+
+    /// Buffers of one scalar type: (bodies, modal) pairs.
+    type Buffers<T> = Vec<(Vec<LocalBody<T>>, Vec<[Vec<T>; 3]>)>;
+
+    /// At most this many buffer pairs are kept per type (contexts alive at once: nested
+    /// evaluations hold a few).
+    const KEEP: usize = 16;
+
+    thread_local! {
+        static SPARE: RefCell<Vec<(TypeId, Box<dyn Any>)>> = const { RefCell::new(Vec::new()) };
+    }
+
+    /// Empty `bodies` and a `modal` of any length (entries to be overwritten), from the
+    /// spares when there are some.
+    pub(super) fn take<T: Real>() -> (Vec<LocalBody<T>>, Vec<[Vec<T>; 3]>) {
+        let got = SPARE.try_with(|s| {
+            let mut s = s.try_borrow_mut().ok()?;
+            let (_, any) = s.iter_mut().find(|(id, _)| *id == TypeId::of::<T>())?;
+            any.downcast_mut::<Buffers<T>>()?.pop()
+        });
+        got.ok().flatten().unwrap_or_default()
+    }
+
+    /// Keep a context's buffers for the next one (dropped when the thread ends).
+    pub(super) fn give<T: Real>(mut bodies: Vec<LocalBody<T>>, modal: Vec<[Vec<T>; 3]>) {
+        if bodies.capacity() == 0 && modal.capacity() == 0 {
+            return;
+        }
+        bodies.clear();
+        let _ = SPARE.try_with(|s| {
+            let Ok(mut s) = s.try_borrow_mut() else { return };
+            if !s.iter().any(|(id, _)| *id == TypeId::of::<T>()) {
+                s.push((TypeId::of::<T>(), Box::new(Buffers::<T>::new())));
+            }
+            let (_, any) = s.iter_mut().find(|(id, _)| *id == TypeId::of::<T>()).expect("just inserted");
+            if let Some(list) = any.downcast_mut::<Buffers<T>>()
+                && list.len() < KEEP
+            {
+                list.push((bodies, modal));
+            }
+        });
     }
 }
