@@ -348,11 +348,12 @@ fn the_residual_of_rigid_bodies_and_joints_allocates_nothing_after_the_first_cal
 }
 
 /// Allocations per 1 ms `fmi2DoStep` of the pendulum FMU with its outputs read after
-/// each, at most. Measured: 3.0 (2026-12-04, was 11.6 before the angle-branch recording,
-/// the outputs and fmi2GetReal reused their buffers); all of them in the Jacobian
-/// refreshes (about one per four steps), which still allocate (the test below pins the
-/// steps without one at zero). 1.5 times the measured value.
-const ALLOCATIONS_PER_DO_STEP_BOUND: f64 = 4.5;
+/// each, at most. Measured: 0.075 (2026-12-04; 11.6 before the angle-branch recording,
+/// the outputs, fmi2GetReal and the Jacobian reused their buffers), all of them faer's:
+/// its supernodal numeric LU allocates a work list per factorization, and a step factors
+/// anew about once in 30 (the test below pins the other steps to zero). Twice the
+/// measured value.
+const ALLOCATIONS_PER_DO_STEP_BOUND: f64 = 0.15;
 
 /// A host's 1 ms co-simulation loop on the pendulum FMU: 1000 `fmi2DoStep` calls after
 /// a warm-up of 0.3 s, each followed by fmi2GetReal of every output, as a master does.
@@ -410,12 +411,14 @@ fn golden_outputs(name: &str) -> Vec<u32> {
 /// The integrator's steady-state step allocates nothing (issue 26): on rigid models of
 /// joints and outputs (a chain, a closed loop with redundant rows, a spinning top, and
 /// the swing chain of the benchmarks), 1 ms communication steps with the outputs read
-/// after each, every step that neither refreshes the Jacobian nor factors anew makes
-/// zero allocations (f, the Newton iterations, the error estimate, the angle-branch
-/// recording, the outputs). Such steps must be most of them, so the check cannot pass
-/// vacuously. Counted per thread.
+/// after each. A step that keeps its factorization (f, the Newton iterations, the error
+/// estimate, the angle-branch recording, the outputs) makes zero allocations. One that
+/// factors anew also evaluates the Jacobian in reused buffers, but faer's supernodal
+/// numeric LU allocates its work lists (1 to 10 per factorization on these models), so
+/// those steps are not held to zero. Steps of the first kind must be most of them, so the
+/// check cannot pass vacuously. Counted per thread.
 #[test]
-fn integrator_steps_without_a_jacobian_refresh_allocate_nothing() {
+fn integrator_steps_that_keep_their_factorization_allocate_nothing() {
     let _one = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     let chain = std::process::Command::new("bash")
@@ -450,16 +453,16 @@ fn integrator_steps_without_a_jacobian_refresh_allocate_nothing() {
             sim.advance(k as f64 * h).unwrap();
             sim.outputs_into(&mut out).unwrap();
             let (s1, made) = (sim.stats(), thread_allocations() - before);
-            if s1.jacobians == s0.jacobians && s1.factorizations == s0.factorizations {
+            if s1.factorizations == s0.factorizations {
                 quiet += 1;
                 if made > 0 {
-                    with_allocations.push((k, made));
+                    with_allocations.push((k, made, s1.jacobians - s0.jacobians));
                 }
             }
         }
-        println!("{name}: {quiet} of 500 steps without a Jacobian refresh or factorization");
-        assert!(with_allocations.is_empty(), "{name}: (step, allocations) {with_allocations:?}");
-        assert!(quiet >= 250, "{name}: only {quiet} of 500 steps kept their Jacobian");
+        println!("{name}: {quiet} of 500 steps without a new factorization");
+        assert!(with_allocations.is_empty(), "{name}: (step, allocations, Jacobians) {with_allocations:?}");
+        assert!(quiet >= 250, "{name}: only {quiet} of 500 steps kept their factorization");
         assert!(out.iter().all(|v| v.is_finite()));
     }
 }

@@ -10,7 +10,7 @@
 //! ([`super::jacobian`]), M is [`mass_matrix`] (here). The constraint rows come from
 //! [`crate::mechanics::constraint_jacobian`], M's blocks from [`crate::mechanics::mass`].
 
-pub use super::jacobian::jacobian;
+pub use super::jacobian::{JacScratch, jacobian, jacobian_with};
 pub use super::layout::Layout;
 pub use super::residual::{RhsScratch, rhs};
 use super::sparse::Triplets;

@@ -6,12 +6,12 @@ use super::sparse::Triplets;
 use crate::ad::chunked;
 use crate::mechanics::System;
 use crate::mechanics::body::{NQ, h_angular};
-use crate::mechanics::constraint_jacobian::p_row;
-use crate::mechanics::coords::{gather, global_column, nql, rates};
+use crate::mechanics::constraint_jacobian::p_row_into;
+use crate::mechanics::coords::{gather_into, global_column, nql, rates_into};
 use crate::mechanics::flexible;
 use crate::mechanics::kernels::{
-    constraint_second, dhtw_dq, dqdot_dq, force_ext_jacobian, force_jacobian, gyroscopic, nonholonomic_second,
-    user_jacobian,
+    ConstraintSecond, constraint_second_into, dhtw_dq, dqdot_dq, force_ext_jacobian, force_jacobian, gyroscopic,
+    nonholonomic_second, user_jacobian,
 };
 use crate::mechanics::loads::{LoadGradient, LoadTerm, NLOAD, load_gradient};
 use crate::mechanics::mass::body_mass_entries;
@@ -30,15 +30,54 @@ struct At<'a> {
 
 /// J = ∂f/∂y, exact except for the term ∂(C_qᵀμ)/∂q, which vanishes on the solution (μ = 0).
 pub fn jacobian(sys: &System, lay: Layout, t: f64, y: &[f64], inputs: &[f64], jac: &mut Triplets) {
-    let ext = lay.ext(sys, inputs, y, t);
-    let at = At { sys, lay, t, y, q: &y[lay.q_range()], u: &y[lay.u_range()], ext: &ext };
-    let lc = LoadChain::new(sys, lay, y, t, &ext);
+    jacobian_with(sys, lay, t, y, inputs, &mut JacScratch::default(), jac);
+}
+
+/// The buffers [`jacobian_with`] works in, reused from call to call: the joints between
+/// rigid bodies (closed form) and the bodies then allocate nothing.
+#[derive(Clone, Debug, Default)]
+pub struct JacScratch {
+    /// The external values.
+    ext: Vec<f64>,
+    rows: RowBuffers,
+}
+
+/// Buffers of one constraint element's rows.
+#[derive(Clone, Debug, Default)]
+struct RowBuffers {
+    second: ConstraintSecond,
+    /// The element's local q and u.
+    ql: Vec<f64>,
+    ul: Vec<f64>,
+    rates: BodyRates,
+    /// (Pᵀλ)_q, local.
+    lq: Vec<f64>,
+    /// A P row, a Hessian column and its Hᵀ product.
+    p: Vec<f64>,
+    col: Vec<f64>,
+    ht: Vec<f64>,
+}
+
+/// [`jacobian`] in the buffers `ws`.
+pub fn jacobian_with(
+    sys: &System,
+    lay: Layout,
+    t: f64,
+    y: &[f64],
+    inputs: &[f64],
+    ws: &mut JacScratch,
+    jac: &mut Triplets,
+) {
+    lay.ext_into(sys, inputs, y, t, &mut ws.ext);
+    let ext = &ws.ext;
+    let at = At { sys, lay, t, y, q: &y[lay.q_range()], u: &y[lay.u_range()], ext };
+    let lc = LoadChain::new(sys, lay, y, t, ext);
     user_rows(&at, &lc, jac);
     kinematic_rows(&at, jac);
     flexible_rows(&at, jac);
     nonholonomic_rows(&at, jac);
     force_rows(&at, &lc, jac);
-    constraint_rows(&at, jac);
+    constraint_rows(&at, &mut ws.rows, jac);
     acceleration_rows(&at, jac);
 }
 
@@ -189,14 +228,16 @@ fn force_rows(at: &At, lc: &LoadChain, jac: &mut Triplets) {
 
 /// ∂/∂y of C (λ rows), Ċ (μ rows), −Pᵀλ (force balance) and −C_qᵀμ (q̇ rows); a
 /// redundant row has the identity (λ = μ = 0).
-fn constraint_rows(at: &At, jac: &mut Triplets) {
+fn constraint_rows(at: &At, ws: &mut RowBuffers, jac: &mut Triplets) {
     let (nl, nm) = (at.lay.lam(), at.lay.mu());
     for el in &at.sys.constraints {
-        let s = constraint_second(at.sys, el, at.q, at.t, at.ext);
+        constraint_second_into(at.sys, el, at.q, at.t, at.ext, &mut ws.second);
+        let s = &ws.second;
         let nql = nql(at.sys, &el.bodies);
         let k = s.k;
-        let rates = body_rates(at.sys, &el.bodies, at.q, at.u);
-        let mut lq = vec![0.0; nql * nql];
+        body_rates_into(at.sys, &el.bodies, at.q, at.u, (&mut ws.ql, &mut ws.ul), &mut ws.rates);
+        ws.lq.clear();
+        ws.lq.resize(nql * nql, 0.0);
         for e in 0..el.neq {
             let row = el.row + e;
             if at.sys.redundant[row] {
@@ -207,16 +248,17 @@ fn constraint_rows(at: &At, jac: &mut Triplets) {
             let lam = at.y[nl + row];
             let g = &s.grad[e * k..(e + 1) * k];
             let hs = &s.hess[e * k * k..(e + 1) * k * k];
-            constraint_row(at, &el.bodies, row, g, hs, &rates, jac);
+            constraint_row(at, &el.bodies, row, g, hs, &ws.rates, &mut ws.p, jac);
             if lam != 0.0 {
-                add_pt_lambda_q(at.sys, &el.bodies, at.q, lam, g, hs, &mut lq);
+                add_pt_lambda_q(at.sys, &el.bodies, at.q, lam, g, hs, (&mut ws.col, &mut ws.ht), &mut ws.lq);
             }
         }
-        push_pt_lambda_q(at, &el.bodies, &lq, jac);
+        push_pt_lambda_q(at, &el.bodies, &ws.lq, jac);
     }
 }
 
 /// q̇ = H(q) u of an element's bodies and ∂q̇/∂q of each body.
+#[derive(Clone, Debug, Default)]
 struct BodyRates {
     /// q̇, local (6 per body, then the modal rates η̇).
     qd: Vec<f64>,
@@ -224,22 +266,41 @@ struct BodyRates {
     dq: Vec<[f64; 36]>,
 }
 
-/// The [`BodyRates`] of `bodies` at global (q, u).
-fn body_rates(sys: &System, bodies: &[usize], q: &[f64], u: &[f64]) -> BodyRates {
-    let ql = gather(sys, bodies, q);
-    let ul = gather(sys, bodies, u);
-    let qd = rates(bodies.len(), &ql, &ul);
-    let dq = (0..bodies.len()).map(|kb| dqdot_dq(&ql[NQ * kb..NQ * kb + NQ], &ul[NQ * kb..NQ * kb + NQ])).collect();
-    BodyRates { qd, dq }
+/// The [`BodyRates`] of `bodies` at global (q, u) into `out`, gathering into `local`.
+fn body_rates_into(
+    sys: &System,
+    bodies: &[usize],
+    q: &[f64],
+    u: &[f64],
+    local: (&mut Vec<f64>, &mut Vec<f64>),
+    out: &mut BodyRates,
+) {
+    let (ql, ul) = local;
+    gather_into(sys, bodies, q, ql);
+    gather_into(sys, bodies, u, ul);
+    rates_into(bodies.len(), ql, ul, &mut out.qd);
+    out.dq.clear();
+    out.dq.extend((0..bodies.len()).map(|kb| dqdot_dq(&ql[NQ * kb..NQ * kb + NQ], &ul[NQ * kb..NQ * kb + NQ])));
 }
 
 /// The entries of one non-redundant constraint equation `row` with gradient `g` and
 /// Hessian `hs` (local q then t, k = g.len()): C_q in its λ row, −C_qᵀ in its μ column
-/// (q̇ rows), −Pᵀ in its λ column (u rows), P and Ċ_q in its μ row.
-fn constraint_row(at: &At, bodies: &[usize], row: usize, g: &[f64], hs: &[f64], rates: &BodyRates, jac: &mut Triplets) {
+/// (q̇ rows), −Pᵀ in its λ column (u rows), P and Ċ_q in its μ row (`p`: a buffer).
+#[allow(clippy::too_many_arguments)]
+fn constraint_row(
+    at: &At,
+    bodies: &[usize],
+    row: usize,
+    g: &[f64],
+    hs: &[f64],
+    rates: &BodyRates,
+    p: &mut Vec<f64>,
+    jac: &mut Triplets,
+) {
     let (nu, nl, nm) = (at.lay.u(), at.lay.lam(), at.lay.mu());
     let (nql, k) = (nql(at.sys, bodies), g.len());
-    let p = p_row(bodies, at.q, &g[..nql]);
+    p.resize(nql, 0.0);
+    p_row_into(bodies, |b| h_angular(at.q[NQ * b + 4], at.q[NQ * b + 5]), &g[..nql], p);
     for a in 0..nql {
         let ga = global_column(at.sys, bodies, a);
         // C_q (Eq. 13e rows), −C_qᵀ (q̇ rows, μ column), −Pᵀ (u rows, λ column), P (Ċ rows).
@@ -263,12 +324,25 @@ fn constraint_row(at: &At, bodies: &[usize], row: usize, g: &[f64], hs: &[f64], 
 }
 
 /// Add one equation's (Pᵀλ)_q = λ [Hᵀ ∂C_q/∂q + ∂(Hᵀ w)/∂q |_{w = C_q}] to `lq` (local,
-/// row-major nql × nql), from its gradient `g` and Hessian `hs`.
-fn add_pt_lambda_q(sys: &System, bodies: &[usize], q: &[f64], lam: f64, g: &[f64], hs: &[f64], lq: &mut [f64]) {
+/// row-major nql × nql), from its gradient `g` and Hessian `hs` (`bufs`: two buffers).
+#[allow(clippy::too_many_arguments)]
+fn add_pt_lambda_q(
+    sys: &System,
+    bodies: &[usize],
+    q: &[f64],
+    lam: f64,
+    g: &[f64],
+    hs: &[f64],
+    bufs: (&mut Vec<f64>, &mut Vec<f64>),
+    lq: &mut [f64],
+) {
     let (nql, k) = (nql(sys, bodies), g.len());
+    let (col, ht) = bufs;
+    ht.resize(nql, 0.0);
     for a in 0..nql {
-        let col: Vec<f64> = (0..nql).map(|c| hs[c * k + a]).collect();
-        let ht = p_row(bodies, q, &col);
+        col.clear();
+        col.extend((0..nql).map(|c| hs[c * k + a]));
+        p_row_into(bodies, |b| h_angular(q[NQ * b + 4], q[NQ * b + 5]), col, ht);
         for r in 0..nql {
             lq[r * nql + a] += lam * ht[r];
         }

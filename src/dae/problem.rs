@@ -2,7 +2,7 @@
 //! of each component, inputs interpolated over a step, and what happens after each
 //! accepted step (re-based Euler frames, recorded angle branches).
 
-use super::equations::{self, Layout};
+use super::equations::{self, JacScratch, Layout};
 use super::radau::DaeProblem;
 use super::residual::RhsScratch;
 use super::sparse::Triplets;
@@ -22,6 +22,8 @@ pub(super) struct MultibodyDae {
     /// The inputs at the time of the last [`DaeProblem::rhs`], and that function's buffers.
     inputs_now: Vec<f64>,
     ws: RhsScratch,
+    /// The Jacobian's buffers.
+    jws: JacScratch,
     /// Buffers of the angle-branch recording at accepted steps: the inputs, the external
     /// values and the recording's own.
     accepted_inputs: Vec<f64>,
@@ -39,7 +41,8 @@ impl DaeProblem for MultibodyDae {
         if f.iter().all(|v| v.is_finite()) { Ok(()) } else { Err("non-finite equations".into()) }
     }
     fn jacobian(&mut self, t: f64, y: &[f64], j: &mut Triplets) -> Result<(), String> {
-        equations::jacobian(&self.sys, self.lay, t, y, &self.inputs_at(t), j);
+        interpolate(&self.inputs, &self.slopes, t - self.t_in, &mut self.inputs_now);
+        equations::jacobian_with(&self.sys, self.lay, t, y, &self.inputs_now, &mut self.jws, j);
         Ok(())
     }
     fn mass(&self, m: &mut Triplets) {
@@ -73,6 +76,7 @@ impl MultibodyDae {
             t_in,
             inputs_now: Vec::new(),
             ws: RhsScratch::default(),
+            jws: JacScratch::default(),
             accepted_inputs: Vec::new(),
             accepted_ext: Vec::new(),
             angles: AngleScratch::default(),

@@ -117,6 +117,8 @@ pub struct Radau {
     work: Work,
     h_fact: f64,
     cont: Option<[Vec<f64>; 3]>,
+    /// The buffers of a dropped polynomial, for the next one (nothing allocated).
+    spare_cont: Option<[Vec<f64>; 3]>,
     h_old: f64,
     first: bool,
     last_rejected: bool,
@@ -188,6 +190,7 @@ impl Radau {
             work: Work::default(),
             h_fact: f64::NAN,
             cont: None,
+            spare_cont: None,
             h_old: 0.0,
             first: true,
             last_rejected: false,
@@ -201,7 +204,7 @@ impl Radau {
     /// Newton history. After a reset the future depends only on (t, y, h), which makes a
     /// restored state reproduce a run bit for bit.
     pub fn reset(&mut self) {
-        self.cont = None;
+        self.drop_polynomial();
         self.need_jac = true;
         self.jac_fresh = false;
         self.h_fact = f64::NAN;
@@ -444,6 +447,13 @@ impl Radau {
         Ok(())
     }
 
+    /// Forget the collocation polynomial (its buffers are kept for the next one).
+    fn drop_polynomial(&mut self) {
+        if let Some(c) = self.cont.take() {
+            self.spare_cont = Some(c);
+        }
+    }
+
     /// Starting values of the stage increments Z: the previous collocation polynomial
     /// extrapolated (zero without one).
     fn predict_stages(&self, h: f64, z: &mut [Vec<f64>; 3]) {
@@ -631,7 +641,8 @@ impl Radau {
             hnew = hnew.min(h);
         }
         let c = self.tb.c;
-        let cc = self.cont.get_or_insert_with(|| std::array::from_fn(|_| vec![0.0; n]));
+        let spare = &mut self.spare_cont;
+        let cc = self.cont.get_or_insert_with(|| spare.take().unwrap_or_else(|| std::array::from_fn(|_| vec![0.0; n])));
         for i in 0..n {
             let (z1, z2, z3) = (z[0][i], z[1][i], z[2][i]);
             let ak = (z1 - z2) / (c[0] - c[1]);
@@ -650,7 +661,7 @@ impl Radau {
         self.need_jac = theta > THET;
         self.f0_valid = false;
         if p.accepted(self.t, &mut self.y) {
-            self.cont = None;
+            self.drop_polynomial();
             self.need_jac = true;
         }
         // Keep h (and the factorization) when the change would be small (RADAU5's
@@ -714,7 +725,7 @@ impl Radau {
         self.last_reject = why;
         self.last_rejected = true;
         self.need_jac = !self.jac_fresh;
-        self.cont = None;
+        self.drop_polynomial();
         0.5 * h
     }
 }

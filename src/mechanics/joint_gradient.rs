@@ -11,9 +11,8 @@
 
 use super::body::{NQ, Turn};
 use super::constraints::{ConstraintEl, ConstraintKind};
-use super::coords::{gather, nql};
+use super::coords::nql;
 use super::system::System;
-use crate::ad::chunked::seed;
 use crate::ad::{Dual, Real};
 use crate::geom::{M3, V3};
 use crate::model::JointType;
@@ -201,34 +200,63 @@ pub type Second = (Vec<f64>, Vec<f64>, Vec<f64>);
 /// The [`Second`] derivatives of `el` when it is a joint whose markers are on rigid
 /// bodies or ground, between at most two bodies; None otherwise.
 pub fn joint_second(sys: &System, el: &ConstraintEl, q: &[f64]) -> Option<Second> {
-    let joint = rigid_joint(sys, el)?;
-    let ql = gather(sys, &el.bodies, q);
-    match ql.len() {
-        0 => None,
-        6 => Some(second::<6>(sys, el, joint, &ql)),
-        12 => Some(second::<12>(sys, el, joint, &ql)),
-        _ => None,
-    }
+    let (mut c, mut grad, mut hess) = (Vec::new(), Vec::new(), Vec::new());
+    joint_second_into(sys, el, q, &mut c, &mut grad, &mut hess).then_some((c, grad, hess))
 }
 
-fn second<const K: usize>(sys: &System, el: &ConstraintEl, joint: (usize, usize, JointType), ql: &[f64]) -> Second {
-    let nq = ql.len();
-    let k = nq + 1;
-    let x: Vec<Dual<f64, K>> = seed(ql, 0, &(0..K));
+/// Most equations of a joint (a fixed joint's six).
+const MAX_EQ: usize = 6;
+
+/// [`joint_second`] into `c`, `grad` and `hess` (resized, capacities reused; global
+/// `q`); false (nothing written) when `el` is not such a joint.
+pub fn joint_second_into(
+    sys: &System,
+    el: &ConstraintEl,
+    q: &[f64],
+    c: &mut Vec<f64>,
+    grad: &mut Vec<f64>,
+    hess: &mut Vec<f64>,
+) -> bool {
+    let Some(joint) = rigid_joint(sys, el) else { return false };
+    match nql(sys, &el.bodies) {
+        6 => second::<6>(sys, el, joint, q, c, grad, hess),
+        12 => second::<12>(sys, el, joint, q, c, grad, hess),
+        _ => return false,
+    }
+    true
+}
+
+fn second<const K: usize>(
+    sys: &System,
+    el: &ConstraintEl,
+    joint: (usize, usize, JointType),
+    q: &[f64],
+    c_out: &mut Vec<f64>,
+    grad: &mut Vec<f64>,
+    hess: &mut Vec<f64>,
+) {
+    let (nq, k, neq) = (K, K + 1, el.neq);
+    assert!(neq <= MAX_EQ, "a joint has at most {MAX_EQ} equations");
+    // Local coordinate a is global NQ·bodies[a / NQ] + a % NQ (rigid bodies), seeded.
+    let x: [Dual<f64, K>; K] = std::array::from_fn(|a| Dual::var(q[NQ * el.bodies[a / NQ] + a % NQ], a));
     let (i, j, kind) = joint;
     let qb = |k: usize| &x[NQ * k..NQ * k + NQ];
     let (fi, fj) = (Frame::new(sys, el, i, qb, None), Frame::new(sys, el, j, qb, None));
-    let (mut c, mut cq) = (vec![Dual::zero(); el.neq], vec![Dual::zero(); el.neq * nq]);
-    rows(kind, &fi, &fj, &mut c, &mut cq);
-    let (mut grad, mut hess) = (vec![0.0; c.len() * k], vec![0.0; c.len() * k * k]);
-    for e in 0..c.len() {
+    let (mut c, mut cq) = ([Dual::<f64, K>::zero(); MAX_EQ], [[Dual::<f64, K>::zero(); K]; MAX_EQ]);
+    rows(kind, &fi, &fj, &mut c[..neq], cq[..neq].as_flattened_mut());
+    grad.clear();
+    grad.resize(neq * k, 0.0);
+    hess.clear();
+    hess.resize(neq * k * k, 0.0);
+    for e in 0..neq {
         for a in 0..nq {
-            let g = &cq[e * nq + a];
+            let g = &cq[e][a];
             grad[e * k + a] = g.v;
             for b in 0..nq {
                 hess[e * k * k + a * k + b] = g.d[b];
             }
         }
     }
-    (c.iter().map(|v| v.v).collect(), grad, hess)
+    c_out.clear();
+    c_out.extend(c[..neq].iter().map(|v| v.v));
 }

@@ -28,6 +28,7 @@ pub struct ConstraintFirst {
 }
 
 /// C with gradient and Hessian over z = (local q, t); K = nq + 1 (nq local coordinates).
+#[derive(Clone, Debug, Default)]
 pub struct ConstraintSecond {
     /// Number K of variables z.
     pub k: usize,
@@ -132,9 +133,25 @@ fn first_k<const K: usize>(
 /// Second derivatives of a constraint element (for Ċ_q, (Pᵀλ)_q and the γ of Eq. 1c).
 /// Joints between rigid bodies take the closed-form gradient of [`super::joint_gradient`].
 pub fn constraint_second(sys: &System, el: &ConstraintEl, q: &[f64], t: f64, inputs: &[f64]) -> ConstraintSecond {
-    match joint_gradient::joint_second(sys, el, q) {
-        Some((c, grad, hess)) => ConstraintSecond { k: nql(sys, &el.bodies) + 1, c, grad, hess },
-        None => constraint_second_ad(sys, el, q, t, inputs),
+    let mut r = ConstraintSecond::default();
+    constraint_second_into(sys, el, q, t, inputs, &mut r);
+    r
+}
+
+/// [`constraint_second`] into `r` (the closed form of rigid joints reuses its buffers;
+/// the dual-number route replaces them).
+pub fn constraint_second_into(
+    sys: &System,
+    el: &ConstraintEl,
+    q: &[f64],
+    t: f64,
+    inputs: &[f64],
+    r: &mut ConstraintSecond,
+) {
+    if joint_gradient::joint_second_into(sys, el, q, &mut r.c, &mut r.grad, &mut r.hess) {
+        r.k = nql(sys, &el.bodies) + 1;
+    } else {
+        *r = constraint_second_ad(sys, el, q, t, inputs);
     }
 }
 
@@ -399,16 +416,16 @@ fn force_jac_k<const K: usize>(
 
 /// ∂q̇_b/∂q_b (6×6, row-major) for one body: only the Euler-angle rows depend on θ, φ.
 pub fn dqdot_dq(q: &[f64], u: &[f64]) -> [f64; 36] {
-    let qd: Vec<Dual<f64, 6>> = q.iter().enumerate().map(|(k, &v)| Dual::var(v, k)).collect();
-    let ud: Vec<Dual<f64, 6>> = u.iter().map(|&v| Dual::cst(v)).collect();
+    let qd: [Dual<f64, 6>; 6] = std::array::from_fn(|k| Dual::var(q[k], k));
+    let ud: [Dual<f64, 6>; 6] = std::array::from_fn(|k| Dual::cst(u[k]));
     let r = qdot(&qd, &ud);
     std::array::from_fn(|i| r[i / 6].d[i % 6])
 }
 
 /// ∂(Hᵀw)/∂q_b (6×6, row-major) for one body at fixed w.
 pub fn dhtw_dq(q: &[f64], w: &[f64]) -> [f64; 36] {
-    let qd: Vec<Dual<f64, 6>> = q.iter().enumerate().map(|(k, &v)| Dual::var(v, k)).collect();
-    let wd: Vec<Dual<f64, 6>> = w.iter().map(|&v| Dual::cst(v)).collect();
+    let qd: [Dual<f64, 6>; 6] = std::array::from_fn(|k| Dual::var(q[k], k));
+    let wd: [Dual<f64, 6>; 6] = std::array::from_fn(|k| Dual::cst(w[k]));
     let r = h_transpose_times(&qd, &wd);
     std::array::from_fn(|i| r[i / 6].d[i % 6])
 }
