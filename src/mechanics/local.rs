@@ -61,7 +61,8 @@ pub struct LocalCtx<'a, T: Real> {
     /// layout as `inputs`) instead of `inputs`.
     pub input_values: Option<Vec<T>>,
     /// Per local body: its modal coordinates η, rates η̇ and accelerations η̈ (empty for a
-    /// rigid body; rates and accelerations zero when not given).
+    /// rigid body; rates and accelerations zero when not given). Entries past the last
+    /// local body are spare buffers, never read.
     modal: Vec<[Vec<T>; 3]>,
 }
 
@@ -88,8 +89,11 @@ impl<'a, T: Real> LocalCtx<'a, T> {
     /// layout, may be empty = zero).
     pub fn new(sys: &'a System, ids: &'a [usize], q: &[T], u: &[T], udot: &[T], t: T, inputs: &'a [f64]) -> Self {
         let (mut bodies, mut modal) = spare::take::<T>();
-        modal.resize_with(ids.len(), Default::default);
-        for (k, m) in modal.iter_mut().enumerate() {
+        // Entries past ids.len() are left as they are (never read): their buffers stay.
+        if modal.len() < ids.len() {
+            modal.resize_with(ids.len(), Default::default);
+        }
+        for (k, m) in modal.iter_mut().take(ids.len()).enumerate() {
             let r = local_modal_range(sys, ids, k);
             for (part, x) in m.iter_mut().zip([q, u, udot]) {
                 part.clear();
