@@ -7,11 +7,11 @@ use crate::ad::chunked;
 use crate::mechanics::System;
 use crate::mechanics::body::{NQ, h_angular};
 use crate::mechanics::constraint_jacobian::p_row_into;
-use crate::mechanics::coords::{gather_into, global_column, nql, rates_into};
+use crate::mechanics::coords::{global_column, nql, rates_into};
 use crate::mechanics::flexible;
 use crate::mechanics::kernels::{
-    ConstraintSecond, constraint_second_into, dhtw_dq, dqdot_dq, force_ext_jacobian, force_jacobian, gyroscopic,
-    nonholonomic_second, user_jacobian,
+    ConstraintSecond, Gathered, constraint_second_into, dhtw_dq, dqdot_dq, force_ext_jacobian, force_jacobian,
+    gyroscopic, nonholonomic_second, user_jacobian,
 };
 use crate::mechanics::loads::{LoadGradient, LoadTerm, NLOAD, load_gradient};
 use crate::mechanics::mass::body_mass_entries;
@@ -47,8 +47,7 @@ pub struct JacScratch {
 struct RowBuffers {
     second: ConstraintSecond,
     /// The element's local q and u.
-    ql: Vec<f64>,
-    ul: Vec<f64>,
+    local: Gathered,
     rates: BodyRates,
     /// (Pᵀλ)_q, local.
     lq: Vec<f64>,
@@ -235,7 +234,7 @@ fn constraint_rows(at: &At, ws: &mut RowBuffers, jac: &mut Triplets) {
         let s = &ws.second;
         let nql = nql(at.sys, &el.bodies);
         let k = s.k;
-        body_rates_into(at.sys, &el.bodies, at.q, at.u, (&mut ws.ql, &mut ws.ul), &mut ws.rates);
+        body_rates_into(at.sys, &el.bodies, at.q, at.u, &mut ws.local, &mut ws.rates);
         ws.lq.clear();
         ws.lq.resize(nql * nql, 0.0);
         for e in 0..el.neq {
@@ -267,17 +266,8 @@ struct BodyRates {
 }
 
 /// The [`BodyRates`] of `bodies` at global (q, u) into `out`, gathering into `local`.
-fn body_rates_into(
-    sys: &System,
-    bodies: &[usize],
-    q: &[f64],
-    u: &[f64],
-    local: (&mut Vec<f64>, &mut Vec<f64>),
-    out: &mut BodyRates,
-) {
-    let (ql, ul) = local;
-    gather_into(sys, bodies, q, ql);
-    gather_into(sys, bodies, u, ul);
+fn body_rates_into(sys: &System, bodies: &[usize], q: &[f64], u: &[f64], local: &mut Gathered, out: &mut BodyRates) {
+    let (ql, ul) = local.of(sys, bodies, q, u);
     rates_into(bodies.len(), ql, ul, &mut out.qd);
     out.dq.clear();
     out.dq.extend((0..bodies.len()).map(|kb| dqdot_dq(&ql[NQ * kb..NQ * kb + NQ], &ul[NQ * kb..NQ * kb + NQ])));

@@ -272,9 +272,8 @@ impl Instance {
         let mut have_outputs = false;
         let mut states: Option<crate::linearize::StateValues> = None;
         for (&vr, o) in vrs.iter().zip(out.iter_mut()) {
-            let target = self.typed_var(vr, false)?.target;
-            let t = &target;
-            *o = match *t {
+            let t = self.typed_var(vr, false)?.target;
+            *o = match t {
                 Target::Parameter(k) => self.config.params[k],
                 Target::Input(k) if self.initialized() => self.built.as_ref().expect("initialized").sim.input(k),
                 Target::Input(k) => self.config.inputs[k],
@@ -298,7 +297,7 @@ impl Instance {
                         );
                     }
                     let v = states.as_ref().expect("evaluated");
-                    match *t {
+                    match t {
                         Target::State(_) => v.s[k],
                         Target::StateDerivative(_) => v.sd[k],
                         Target::Velocity(_) => v.w[k],
@@ -309,7 +308,7 @@ impl Instance {
                     let sim = self.simulator()?;
                     let nx = sim.system().nx;
                     let z = sim.user_values();
-                    match *t {
+                    match t {
                         Target::Diff(_) => z[k],
                         Target::DiffDerivative(_) => z[nx + k],
                         _ => z[2 * nx + k],

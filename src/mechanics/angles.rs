@@ -53,15 +53,15 @@ impl System {
         let first = ws.holders.is_none();
         let mut found = Holders::default();
         {
-            let AngleScratch { holders, ids, qd, ud, rates, out, rec } = ws;
+            let AngleScratch { holders, ids, qd, ud, scalars, out, rec } = ws;
             let all = Holders::default();
             let h = holders.as_ref().unwrap_or(&all);
             let sys = &*self;
             ids.clear();
             ids.extend(0..sys.nb());
-            rates_into(sys.nb(), q, u, rates);
+            rates_into(sys.nb(), q, u, scalars);
             qd.clear();
-            qd.extend(q.iter().zip(rates.iter()).map(|(&v, &d)| D1 { v, d: [d] }));
+            qd.extend(q.iter().zip(scalars.iter()).map(|(&v, &d)| D1 { v, d: [d] }));
             ud.clear();
             ud.extend(u.iter().map(|&v| D1::cst(v)));
             rec.get_mut().clear();
@@ -127,8 +127,8 @@ impl System {
         };
         for &k in &springs {
             let el = &self.forces[k];
-            gather_into(self, &el.bodies, q, &mut ws.rates);
-            let ctx = LocalCtx::new(self, &el.bodies, &ws.rates, &[], &[], t, ext);
+            gather_into(self, &el.bodies, q, &mut ws.scalars);
+            let ctx = LocalCtx::new(self, &el.bodies, &ws.scalars, &[], &[], t, ext);
             let a = el.angle(&ctx);
             drop(ctx);
             if first && a.is_some() {
@@ -170,7 +170,8 @@ pub struct AngleScratch {
     ids: Vec<usize>,
     qd: Vec<D1>,
     ud: Vec<D1>,
-    rates: Vec<f64>,
+    /// q̇ along the motion, then a rotational spring's local q.
+    scalars: Vec<f64>,
     out: Vec<D1>,
     rec: AngleRecord,
 }
