@@ -11,7 +11,7 @@ use clap::Args;
 use super::input_csv::InputTable;
 use super::{CliError, SetArgs};
 use crate::dae::{BATCH_MAX_STEPS, SimOptions, Simulator};
-use crate::linearize::eigen::{eigen_table, format_table};
+use crate::linearize::eigen::{eigen_table_structured, format_table};
 use crate::linearize::{Linearization, Selection, linearize, selection_at_start, state_values};
 use crate::model::Model;
 
@@ -137,10 +137,11 @@ fn print_equilibrium(sim: &mut Simulator, sel: &Selection, t0: f64, rep: &mut dy
 /// Print the eigenvalue table of the linearization `lin` at `t`, with a note on the zero
 /// eigenvalues that non-holonomic constraints imply.
 fn print_eigenvalues(lin: &Linearization, sel: &Selection, t: f64, rep: &mut dyn Write) -> Result<(), CliError> {
-    let rows = eigen_table(&lin.a).map_err(|e| CliError::Engine(e.into()))?;
-    writeln!(rep, "\nt = {t}: {} states, {} eigenvalues", lin.states.len(), lin.a.nrows()).map_err(io_err)?;
-    write!(rep, "{}", format_table(&rows)).map_err(io_err)?;
     let (s0, s1) = (sel.states.len(), sel.velocities.len());
+    let (rows, route) = eigen_table_structured(&lin.a, s0, s1).map_err(|e| CliError::Engine(e.into()))?;
+    writeln!(rep, "\nt = {t}: {} states, {} eigenvalues ({})", lin.states.len(), lin.a.nrows(), route.describe())
+        .map_err(io_err)?;
+    write!(rep, "{}", format_table(&rows)).map_err(io_err)?;
     if s1 < s0 {
         writeln!(
             rep,

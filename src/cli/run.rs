@@ -7,7 +7,7 @@ use std::io::Write;
 use super::CliError;
 use super::simulate::{RunSettings, drive, header};
 use crate::dae::{SimOptions, Simulator};
-use crate::linearize::eigen::{eigen_table, format_table};
+use crate::linearize::eigen::{eigen_table_structured, format_table};
 use crate::linearize::{linearize, selection_at_start};
 use crate::model::parse::load_str;
 
@@ -38,7 +38,8 @@ pub fn run(out: &mut dyn Write) -> Result<(), CliError> {
     let mut sim = Simulator::new(&at_rest, SimOptions { tol: 1e-10, max_step: None, ..Default::default() }, 0.0)?;
     let sel = selection_at_start(&at_rest)?;
     let lin = linearize(&mut sim, &sel, 2)?;
-    let rows = eigen_table(&lin.a).map_err(|e| CliError::Engine(e.into()))?;
+    let (rows, _) = eigen_table_structured(&lin.a, sel.states.len(), sel.velocities.len())
+        .map_err(|e| CliError::Engine(e.into()))?;
     writeln!(out, "{DEFAULT_MODEL_FILE} at rest (th1 = th2 = 0), linearized in {}:", lin.states.join(", "))
         .map_err(io_err)?;
     write!(out, "{}", format_table(&rows)).map_err(io_err)?;

@@ -22,6 +22,7 @@ mod cli_linearize;
 mod cli_set;
 mod cli_stats;
 mod dependencies;
+mod eigen_routes;
 mod elements;
 mod expr_derivatives;
 mod flexible;
