@@ -11,9 +11,11 @@ use clap::Args;
 use super::input_csv::InputTable;
 use super::{CliError, SetArgs};
 use crate::dae::{BATCH_MAX_STEPS, SimOptions, Simulator};
-use crate::linearize::eigen::{eigen_table_structured, format_table};
+use crate::linearize::eigen::{eigenvalues, format_table, rows_of_eigenvalues};
+use crate::linearize::modes::{equilibrium_residual, shift_invert_modes};
 use crate::linearize::{Linearization, Selection, linearize, selection_at_start, state_values};
 use crate::model::Model;
+use faer::c64;
 
 /// Integration tolerance when neither `--tol` nor the model's experiment gives one.
 pub const DEFAULT_TOL: f64 = 1e-8;
@@ -53,6 +55,15 @@ pub struct LinearizeArgs {
     /// Threads for the right-hand sides of the augmented system.
     #[arg(long, default_value_t = 2)]
     pub threads: usize,
+    /// Only the K eigenvalues nearest --shift, by shift-invert Arnoldi on the sparse
+    /// linearized DAE (its Jacobian pencil), never forming A: for large models. At an
+    /// equilibrium only (there the pencil's finite eigenvalues are A's); writes the
+    /// table, or JSON with the eigenvalues and no matrices.
+    #[arg(long, value_name = "K")]
+    pub modes: Option<usize>,
+    /// The shift of --modes [rad/s] (default 0: the lowest frequencies).
+    #[arg(long, value_name = "SIGMA", default_value_t = 0.0, allow_negative_numbers = true)]
+    pub shift: f64,
 }
 
 /// Run the command. The report (states, equilibrium, eigenvalue tables) goes to `out`,
@@ -73,14 +84,90 @@ pub fn run(args: &LinearizeArgs, out: &mut dyn Write, report: &mut dyn Write) ->
     if model.static_analysis {
         print_equilibrium(&mut sim, &sel, t0, rep)?;
     }
+    if let Some(k) = args.modes {
+        let items = run_modes(args, k, &mut sim, table.as_ref(), &sel, &times, rep)?;
+        if args.format == "json" {
+            let text = format!("[{}]", items.join(",\n"));
+            match &args.out {
+                Some(p) => std::fs::write(p, text).map_err(|e| CliError::io(format!("writing {}", p.display()), e))?,
+                None => writeln!(out, "{text}").map_err(io_err)?,
+            }
+        }
+        return Ok(());
+    }
     let mut results = Vec::new();
+    let mut eigs = Vec::new();
     for &t in &times {
         super::input_csv::advance(&mut sim, table.as_ref(), t)?;
         let lin = linearize(&mut sim, &sel, args.threads)?;
-        print_eigenvalues(&lin, &sel, t, rep)?;
+        eigs.push(print_eigenvalues(&lin, &sel, t, rep)?);
         results.push(lin);
     }
-    write_matrices(args, &results, out)
+    write_matrices(args, &results, &eigs, out)
+}
+
+/// `--modes K`: at each time, the K eigenvalues nearest `--shift` from the sparse pencil
+/// (no A), printed as a table; returns the JSON object of each time.
+fn run_modes(
+    args: &LinearizeArgs,
+    k: usize,
+    sim: &mut Simulator,
+    table: Option<&InputTable>,
+    sel: &Selection,
+    times: &[f64],
+    rep: &mut dyn Write,
+) -> Result<Vec<String>, CliError> {
+    if matches!(args.format.as_str(), "npz" | "mat") {
+        return Err(CliError::Usage(format!(
+            "--modes writes no matrices: use --format table or json, not {}",
+            args.format
+        )));
+    }
+    let finite = sel.states.len() + sel.velocities.len() + sim.system().nx;
+    let mut items = Vec::new();
+    for &t in times {
+        super::input_csv::advance(sim, table, t)?;
+        let (j, m, f, mult) = sim.pencil()?;
+        let off = equilibrium_residual(&f, &m, &mult);
+        if off > EQUILIBRIUM_TOL {
+            return Err(CliError::Usage(format!(
+                "--modes: t = {t} is not an equilibrium (the equations of motion are off balance by \
+                 {off:.1e} relative; 0 at an equilibrium): only there are the sparse pencil's eigenvalues \
+                 those of A; linearize without --modes, or start at rest (--static)"
+            )));
+        }
+        let modes = shift_invert_modes(&j, &m, f.len(), k, finite, args.shift)
+            .map_err(|e| CliError::Engine(crate::dae::EngineError::Numeric(e)))?;
+        let rows = rows_of_eigenvalues(&modes.eigenvalues);
+        writeln!(
+            rep,
+            "\nt = {t}: {} eigenvalues nearest {} (shift-invert Arnoldi on the sparse pencil, n = {}, subspace {}, \
+             {} solves, {} restarts)",
+            modes.eigenvalues.len(),
+            modes.shift,
+            f.len(),
+            modes.subspace,
+            modes.solves,
+            modes.restarts
+        )
+        .map_err(io_err)?;
+        write!(rep, "{}", format_table(&rows)).map_err(io_err)?;
+        items.push(format!(
+            "{{\"time\": {t:e}, \"route\": \"shift-invert\", \"shift\": {:e}, \"eigenvalues\": {}}}",
+            modes.shift,
+            json_eigenvalues(&modes.eigenvalues)
+        ));
+    }
+    Ok(items)
+}
+
+/// Largest relative imbalance of the equations of motion (see [`equilibrium_residual`])
+/// that `--modes` accepts as an equilibrium.
+const EQUILIBRIUM_TOL: f64 = 1e-6;
+
+/// `[[re, im], …]`.
+fn json_eigenvalues(ev: &[c64]) -> String {
+    format!("[{}]", ev.iter().map(|z| format!("[{:e}, {:e}]", z.re, z.im)).collect::<Vec<_>>().join(", "))
 }
 
 /// An error writing the report or the JSON to their stream.
@@ -136,9 +223,10 @@ fn print_equilibrium(sim: &mut Simulator, sel: &Selection, t0: f64, rep: &mut dy
 
 /// Print the eigenvalue table of the linearization `lin` at `t`, with a note on the zero
 /// eigenvalues that non-holonomic constraints imply.
-fn print_eigenvalues(lin: &Linearization, sel: &Selection, t: f64, rep: &mut dyn Write) -> Result<(), CliError> {
+fn print_eigenvalues(lin: &Linearization, sel: &Selection, t: f64, rep: &mut dyn Write) -> Result<Vec<c64>, CliError> {
     let (s0, s1) = (sel.states.len(), sel.velocities.len());
-    let (rows, route) = eigen_table_structured(&lin.a, s0, s1).map_err(|e| CliError::Engine(e.into()))?;
+    let (ev, route) = eigenvalues(&lin.a, s0, s1).map_err(|e| CliError::Engine(e.into()))?;
+    let rows = rows_of_eigenvalues(&ev);
     writeln!(rep, "\nt = {t}: {} states, {} eigenvalues ({})", lin.states.len(), lin.a.nrows(), route.describe())
         .map_err(io_err)?;
     write!(rep, "{}", format_table(&rows)).map_err(io_err)?;
@@ -153,15 +241,20 @@ fn print_eigenvalues(lin: &Linearization, sel: &Selection, t: f64, rep: &mut dyn
         )
         .map_err(io_err)?;
     }
-    Ok(())
+    Ok(ev)
 }
 
 /// Write A, B, C, D of every linearization as `--format` asks: JSON to `--out` (else to
 /// `out`), npz or mat to `--out` (required); nothing for a table.
-fn write_matrices(args: &LinearizeArgs, results: &[Linearization], out: &mut dyn Write) -> Result<(), CliError> {
+fn write_matrices(
+    args: &LinearizeArgs,
+    results: &[Linearization],
+    eigs: &[Vec<c64>],
+    out: &mut dyn Write,
+) -> Result<(), CliError> {
     match args.format.as_str() {
         "json" => {
-            let text = to_json(results);
+            let text = to_json(results, eigs);
             match &args.out {
                 Some(p) => std::fs::write(p, text).map_err(|e| CliError::io(format!("writing {}", p.display()), e))?,
                 None => writeln!(out, "{text}").map_err(io_err)?,
@@ -208,13 +301,14 @@ fn json_names(v: &[String]) -> String {
     )
 }
 
-/// The linearizations as a JSON array.
-pub fn to_json(results: &[Linearization]) -> String {
+/// The linearizations as a JSON array, each with its eigenvalues (`[[re, im], …]`).
+pub fn to_json(results: &[Linearization], eigs: &[Vec<c64>]) -> String {
     let items: Vec<String> = results
         .iter()
-        .map(|l| {
+        .zip(eigs)
+        .map(|(l, ev)| {
             format!(
-                "{{\"time\": {:e}, \"states\": {}, \"inputs\": {}, \"outputs\": {}, \"A\": {}, \"B\": {}, \"C\": {}, \"D\": {}}}",
+                "{{\"time\": {:e}, \"states\": {}, \"inputs\": {}, \"outputs\": {}, \"A\": {}, \"B\": {}, \"C\": {}, \"D\": {}, \"eigenvalues\": {}}}",
                 l.time,
                 json_names(&l.states),
                 json_names(&l.inputs),
@@ -222,7 +316,8 @@ pub fn to_json(results: &[Linearization]) -> String {
                 json_matrix(&l.a),
                 json_matrix(&l.b),
                 json_matrix(&l.c),
-                json_matrix(&l.d)
+                json_matrix(&l.d),
+                json_eigenvalues(ev)
             )
         })
         .collect();

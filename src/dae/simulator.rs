@@ -7,7 +7,7 @@ use super::init;
 use super::options::SimOptions;
 use super::problem::MultibodyDae;
 use super::radau::{DaeProblem, Radau, Stats};
-use super::sparse::SparseLu;
+use super::sparse::{SparseLu, Triplets};
 use super::start_values::{START_VALUE_TAG, StartValues};
 use crate::mechanics::System;
 use crate::model::{Model, ModelError};
@@ -139,6 +139,20 @@ impl Simulator {
         // saved state holds them, so a restored one reproduces the run bit for bit).
         self.radau.new_interval();
         self.radau.advance(&mut self.dae, t_end).map_err(EngineError::Numeric)
+    }
+
+    /// The pencil (J, M) of the DAE M y' = f(t, y) at the current point, J = ∂f/∂y exact
+    /// and sparse (the integrator's), with f there and the multipliers (λ, ν) of y.
+    pub fn pencil(&mut self) -> Result<(Triplets, Triplets, Vec<f64>, Vec<f64>), EngineError> {
+        let (t, y) = (self.radau.t, self.radau.y.clone());
+        let mut j = Triplets::new();
+        self.dae.jacobian(t, &y, &mut j).map_err(EngineError::Numeric)?;
+        let mut m = Triplets::new();
+        self.dae.mass(&mut m);
+        let mut f = vec![0.0; y.len()];
+        self.dae.rhs(t, &y, &mut f).map_err(EngineError::Numeric)?;
+        let mult = y[self.dae.lay.multipliers_range()].to_vec();
+        Ok((j, m, f, mult))
     }
 
     /// Integrator statistics so far.

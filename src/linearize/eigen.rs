@@ -118,6 +118,10 @@ pub fn eigen_table(a: &Mat<f64>) -> Result<Vec<EigenRow>, String> {
 }
 
 /// Table rows of eigenvalues `ev` (a set closed under conjugation).
+pub fn rows_of_eigenvalues(ev: &[c64]) -> Vec<EigenRow> {
+    rows_of(ev)
+}
+
 fn rows_of(ev: &[c64]) -> Vec<EigenRow> {
     let scale = ev.iter().map(|z| z.re.hypot(z.im)).fold(0.0, f64::max).max(1.0);
     let mut rows: Vec<EigenRow> = ev

@@ -11,6 +11,7 @@ pub mod extract;
 pub mod jets;
 pub mod layout;
 pub mod linearization;
+pub mod modes;
 pub mod operating_point;
 pub mod outputs;
 pub mod partition;

@@ -40,6 +40,7 @@ mod memory_valgrind;
 mod modal;
 mod model_description;
 mod models_parse;
+mod modes;
 mod nonholonomic;
 mod pack;
 mod physics;
