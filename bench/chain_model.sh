@@ -1,9 +1,13 @@
 #!/usr/bin/env bash
 # The N-link spatial pendulum chain of bench/chain.sh (see there), on stdout:
 # bench/chain_model.sh N > chainN.xml
+# bench/chain_model.sh N hanging > hangN.xml   (links straight down: the chain at rest,
+#                                               an equilibrium, for eigenvalues)
 set -euo pipefail
-[ $# -eq 1 ] || { echo "usage: $0 N" >&2; exit 2; }
-awk -v n="$1" '
+[ $# -eq 1 ] || { [ $# -eq 2 ] && [ "$2" = hanging ]; } || { echo "usage: $0 N [hanging]" >&2; exit 2; }
+tilt=0.3
+[ $# -eq 2 ] && tilt=0
+awk -v n="$1" -v tilt="$tilt" '
 BEGIN {
     L = 0.1; m = 0.1; I = m * L * L / 12
     print "<?xml version=\"1.0\" encoding=\"UTF-8\"?>"
@@ -16,7 +20,7 @@ BEGIN {
     px = 0; py = 0; pz = 0
     for (k = 1; k <= n; k++) {
         # link direction: tilted from -z by about 0.3 rad, azimuth varying along the chain
-        dx = 0.3 * cos(0.7 * k); dy = 0.3 * sin(0.7 * k); dz = -1
+        dx = tilt * cos(0.7 * k); dy = tilt * sin(0.7 * k); dz = -1
         norm = sqrt(dx * dx + dy * dy + dz * dz); dx /= norm; dy /= norm; dz /= norm
         # axis of joint k (above the link) and of joint k+1 (at its tip)
         up = (k % 2 == 1) ? "1 0 0" : "0 1 0"
