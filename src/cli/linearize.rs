@@ -87,11 +87,7 @@ pub fn run(args: &LinearizeArgs, out: &mut dyn Write, report: &mut dyn Write) ->
     if let Some(k) = args.modes {
         let items = run_modes(args, k, &mut sim, table.as_ref(), &sel, &times, rep)?;
         if args.format == "json" {
-            let text = format!("[{}]", items.join(",\n"));
-            match &args.out {
-                Some(p) => std::fs::write(p, text).map_err(|e| CliError::io(format!("writing {}", p.display()), e))?,
-                None => writeln!(out, "{text}").map_err(io_err)?,
-            }
+            write_json(args, format!("[{}]", items.join(",\n")), out)?;
         }
         return Ok(());
     }
@@ -253,13 +249,7 @@ fn write_matrices(
     out: &mut dyn Write,
 ) -> Result<(), CliError> {
     match args.format.as_str() {
-        "json" => {
-            let text = to_json(results, eigs);
-            match &args.out {
-                Some(p) => std::fs::write(p, text).map_err(|e| CliError::io(format!("writing {}", p.display()), e))?,
-                None => writeln!(out, "{text}").map_err(io_err)?,
-            }
-        }
+        "json" => write_json(args, to_json(results, eigs), out)?,
         f @ ("npz" | "mat") => {
             let Some(p) = &args.out else { return Err(CliError::Usage(format!("--format {f} needs --out FILE"))) };
             let bytes = if f == "npz" { super::matrices::npz(results) } else { super::matrices::mat_v4(results) };
@@ -268,6 +258,14 @@ fn write_matrices(
         _ => {}
     }
     Ok(())
+}
+
+/// JSON text to `--out`, else to `out`.
+fn write_json(args: &LinearizeArgs, text: String, out: &mut dyn Write) -> Result<(), CliError> {
+    match &args.out {
+        Some(p) => std::fs::write(p, text).map_err(|e| CliError::io(format!("writing {}", p.display()), e)),
+        None => writeln!(out, "{text}").map_err(io_err),
+    }
 }
 
 /// Print the selected states and any dropped user states.

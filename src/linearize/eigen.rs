@@ -32,13 +32,6 @@ impl EigenRoute {
             EigenRoute::General { n } => format!("general route: eig(A), A {n} x {n}"),
         }
     }
-    /// A short name (`second-order`, `general`) for machine-readable output.
-    pub fn name(&self) -> &'static str {
-        match self {
-            EigenRoute::SecondOrder { .. } => "second-order",
-            EigenRoute::General { .. } => "general",
-        }
-    }
 }
 
 /// X when A = [0 I; X Y] with Y = 0 for `s0` position states followed by as many rate
@@ -81,17 +74,21 @@ pub fn eigenvalues(a: &Mat<f64>, s0: usize, s1: usize) -> Result<(Vec<c64>, Eige
         }
         return Ok((ev, EigenRoute::SecondOrder { s: s0 }));
     }
+    Ok((general_eigenvalues(a)?, EigenRoute::General { n: a.nrows() }))
+}
+
+/// The eigenvalues of A by the general dense eigensolver (none for an empty A).
+fn general_eigenvalues(a: &Mat<f64>) -> Result<Vec<c64>, String> {
     if a.nrows() == 0 {
-        return Ok((vec![], EigenRoute::General { n: 0 }));
+        return Ok(vec![]);
     }
-    let ev = a.eigenvalues().map_err(|e| format!("eigenvalues: {e:?}"))?;
-    Ok((ev, EigenRoute::General { n: a.nrows() }))
+    a.eigenvalues().map_err(|e| format!("eigenvalues: {e:?}"))
 }
 
 /// [`eigen_table`] by the cheapest route that fits (see [`eigenvalues`]), and that route.
 pub fn eigen_table_structured(a: &Mat<f64>, s0: usize, s1: usize) -> Result<(Vec<EigenRow>, EigenRoute), String> {
     let (ev, route) = eigenvalues(a, s0, s1)?;
-    Ok((rows_of(&ev), route))
+    Ok((rows_of_eigenvalues(&ev), route))
 }
 
 /// One row of the eigenvalue table.
@@ -110,19 +107,11 @@ pub struct EigenRow {
 /// Eigenvalues of `a` as table rows: real roots first, then complex pairs, each group by
 /// increasing frequency (as the seed's Table 2).
 pub fn eigen_table(a: &Mat<f64>) -> Result<Vec<EigenRow>, String> {
-    if a.nrows() == 0 {
-        return Ok(vec![]);
-    }
-    let ev = a.eigenvalues().map_err(|e| format!("eigenvalues: {e:?}"))?;
-    Ok(rows_of(&ev))
+    Ok(rows_of_eigenvalues(&general_eigenvalues(a)?))
 }
 
 /// Table rows of eigenvalues `ev` (a set closed under conjugation).
 pub fn rows_of_eigenvalues(ev: &[c64]) -> Vec<EigenRow> {
-    rows_of(ev)
-}
-
-fn rows_of(ev: &[c64]) -> Vec<EigenRow> {
     let scale = ev.iter().map(|z| z.re.hypot(z.im)).fold(0.0, f64::max).max(1.0);
     let mut rows: Vec<EigenRow> = ev
         .iter()

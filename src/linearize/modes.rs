@@ -228,8 +228,7 @@ fn arnoldi(op: &mut Operator, k: usize, dim: usize) -> Result<(Vec<c64>, usize),
                     "shift-invert Arnoldi did not converge in {MAX_RESTARTS} restarts (subspace {dim})"
                 ));
             }
-            let mut ev: Vec<c64> = order[..want].iter().map(|&i| s.column_vector()[i]).collect();
-            ev.truncate(want);
+            let ev = order[..want].iter().map(|&i| s.column_vector()[i]).collect();
             return Ok((ev, restarts));
         }
         // Thick restart: keep the real invariant subspace of the wanted Ritz vectors and

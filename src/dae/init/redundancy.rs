@@ -10,8 +10,9 @@ use crate::mechanics::constraint_jacobian::constraint_jacobian;
 pub const REDUNDANCY_TOL: f64 = 1e-6;
 
 /// Constraint rows that depend on others at (q, t): sparse complete-pivoting elimination
-/// of C_qᵀ (ties to the sparser row: only the pivoted columns matter here); the rows that get no pivot are redundant. A non-finite C_q counts as
-/// independent (assembly reports it).
+/// of C_qᵀ (ties to the sparser row: only the pivoted columns matter here); the rows that
+/// get no pivot are redundant. A non-finite C_q counts as independent (assembly reports
+/// it).
 pub fn redundant_rows(sys: &System, q: &[f64], t: f64, inputs: &[f64]) -> Vec<bool> {
     let (n, m) = (sys.n(), sys.m);
     if m == 0 {
