@@ -113,6 +113,12 @@ fn run_modes(
     times: &[f64],
     rep: &mut dyn Write,
 ) -> Result<Vec<String>, CliError> {
+    if k == 0 || !args.shift.is_finite() {
+        return Err(CliError::Usage(format!(
+            "--modes {k} --shift {}: expected at least one mode and a finite shift",
+            args.shift
+        )));
+    }
     if matches!(args.format.as_str(), "npz" | "mat") {
         return Err(CliError::Usage(format!(
             "--modes writes no matrices: use --format table or json, not {}",

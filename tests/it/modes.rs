@@ -150,6 +150,16 @@ fn the_cli_writes_the_modes_as_json_and_refuses_a_moving_point() {
         let d = all.iter().map(pair).map(|w| (w.0 - z.0).hypot(w.1 - z.1)).fold(f64::INFINITY, f64::min);
         assert!(d < 1e-9 * z.1.abs().max(1.0), "{z:?}");
     }
+    // Bad arguments: a usage error naming them, not an empty table or a NaN.
+    for bad in [
+        &["--modes", "0"][..],
+        &["--modes", "3", "--shift", "nan"][..],
+        &["--modes", "3", "--format", "npz", "-o", "x.npz"][..],
+    ] {
+        let o = mbfmu(&[&["linearize", model.to_str().unwrap()][..], bad].concat());
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success() && err.contains("--modes"), "{bad:?}: {err}");
+    }
     // Released from a swing pose the chain is not at an equilibrium: a clear refusal.
     let o = mbfmu(&["linearize", model.to_str().unwrap(), "--modes", "4", "--set", "j1.angle=0.5"]);
     let err = String::from_utf8_lossy(&o.stderr);
