@@ -12,7 +12,7 @@ use super::input_csv::InputTable;
 use super::{CliError, SetArgs};
 use crate::dae::{BATCH_MAX_STEPS, SimOptions, Simulator};
 use crate::linearize::eigen::{eigenvalues, format_table, rows_of_eigenvalues};
-use crate::linearize::modes::{equilibrium_residual, shift_invert_modes};
+use crate::linearize::modes::{equilibrium_residual, format_shift, shift_invert_modes};
 use crate::linearize::{Linearization, Selection, linearize, selection_at_start, state_values};
 use crate::model::Model;
 use faer::c64;
@@ -61,9 +61,10 @@ pub struct LinearizeArgs {
     /// table, or JSON with the eigenvalues and no matrices.
     #[arg(long, value_name = "K")]
     pub modes: Option<usize>,
-    /// The shift of --modes [rad/s] (default 0: the lowest frequencies).
-    #[arg(long, value_name = "SIGMA", default_value_t = 0.0, allow_negative_numbers = true)]
-    pub shift: f64,
+    /// The shift of --modes [rad/s]: real (default 0: the lowest frequencies) or complex,
+    /// e.g. `0+62.8i` for the modes nearest 10 Hz.
+    #[arg(long, value_name = "SIGMA", default_value = "0", allow_negative_numbers = true, value_parser = parse_shift)]
+    pub shift: c64,
 }
 
 /// Run the command. The report (states, equilibrium, eigenvalue tables) goes to `out`,
@@ -113,11 +114,8 @@ fn run_modes(
     times: &[f64],
     rep: &mut dyn Write,
 ) -> Result<Vec<String>, CliError> {
-    if k == 0 || !args.shift.is_finite() {
-        return Err(CliError::Usage(format!(
-            "--modes {k} --shift {}: expected at least one mode and a finite shift",
-            args.shift
-        )));
+    if k == 0 {
+        return Err(CliError::Usage("--modes 0: expected at least one mode".into()));
     }
     if matches!(args.format.as_str(), "npz" | "mat") {
         return Err(CliError::Usage(format!(
@@ -140,13 +138,13 @@ fn run_modes(
         }
         let modes = shift_invert_modes(&j, &m, f.len(), k, finite, args.shift)
             .map_err(|e| CliError::Engine(crate::dae::EngineError::Numeric(e)))?;
-        let rows = rows_of_eigenvalues(&modes.eigenvalues);
+        let rows = rows_of_eigenvalues(&table_values(&modes.eigenvalues, modes.shift));
         writeln!(
             rep,
             "\nt = {t}: {} eigenvalues nearest {} (shift-invert Arnoldi on the sparse pencil, n = {}, subspace {}, \
              {} solves, {} restarts)",
             modes.eigenvalues.len(),
-            modes.shift,
+            format_shift(modes.shift),
             f.len(),
             modes.subspace,
             modes.solves,
@@ -155,12 +153,54 @@ fn run_modes(
         .map_err(io_err)?;
         write!(rep, "{}", format_table(&rows)).map_err(io_err)?;
         items.push(format!(
-            "{{\"time\": {t:e}, \"route\": \"shift-invert\", \"shift\": {:e}, \"eigenvalues\": {}}}",
-            modes.shift,
+            "{{\"time\": {t:e}, \"route\": \"shift-invert\", \"shift\": [{:e}, {:e}], \"eigenvalues\": {}}}",
+            modes.shift.re,
+            modes.shift.im,
             json_eigenvalues(&modes.eigenvalues)
         ));
     }
     Ok(items)
+}
+
+/// The eigenvalues the table shows: as found for a real shift (conjugate pairs, one row
+/// each); for a complex one each stands for its pair, shown with Im ≥ 0, once.
+fn table_values(ev: &[c64], shift: c64) -> Vec<c64> {
+    if shift.im == 0.0 {
+        return ev.to_vec();
+    }
+    let mut shown: Vec<c64> = Vec::with_capacity(ev.len());
+    for z in ev.iter().map(|z| if z.im < 0.0 { z.conj() } else { *z }) {
+        if !shown.iter().any(|w| (w - z).norm() <= 1e-10 * z.norm()) {
+            shown.push(z);
+        }
+    }
+    shown
+}
+
+/// `--shift`: a real number, or a complex one as `RE+IMi`, `RE-IMi` or `IMi` (`j` for `i`
+/// too), finite.
+fn parse_shift(text: &str) -> Result<c64, String> {
+    let bad = || format!("'{text}' is not a finite real or complex number (e.g. 2, -0.5, 0+62.8i, 62.8i)");
+    let t = text.trim();
+    let num = |s: &str| -> Result<f64, String> {
+        let v = match s {
+            "" | "+" => 1.0,
+            "-" => -1.0,
+            _ => s.parse::<f64>().map_err(|_| bad())?,
+        };
+        if v.is_finite() { Ok(v) } else { Err(bad()) }
+    };
+    let Some(body) = t.strip_suffix(['i', 'j']) else {
+        return if t.is_empty() { Err(bad()) } else { num(t).map(|re| c64::new(re, 0.0)) };
+    };
+    // The sign that starts the imaginary part: the last + or − not leading and not an exponent's.
+    let b = body.as_bytes();
+    let split = (1..b.len()).rev().find(|&i| matches!(b[i], b'+' | b'-') && !matches!(b[i - 1], b'e' | b'E'));
+    match split {
+        Some(i) if body[..i].parse::<f64>().is_ok() => Ok(c64::new(num(&body[..i])?, num(&body[i..])?)),
+        Some(_) => Err(bad()),
+        None => Ok(c64::new(0.0, num(body)?)),
+    }
 }
 
 /// Largest relative imbalance of the equations of motion (see [`equilibrium_residual`])

@@ -12,7 +12,7 @@ use mbfmu::model::Model;
 use mbfmu::model::parse::{load_file, load_str};
 
 /// The full route's eigenvalues and the modes route's `k` nearest `shift`, at t = 0.
-fn both_routes(m: &Model, k: usize, shift: f64) -> (Vec<c64>, Vec<c64>) {
+fn both_routes(m: &Model, k: usize, shift: c64) -> (Vec<c64>, Vec<c64>) {
     let mut sim = Simulator::new(m, SimOptions { tol: 1e-10, max_step: None, ..Default::default() }, 0.0).unwrap();
     let sel = select_states(sim.system(), sim.q(), 0.0, &sim.inputs()).unwrap();
     let (j, mass, f, mult) = sim.pencil().unwrap();
@@ -26,8 +26,8 @@ fn both_routes(m: &Model, k: usize, shift: f64) -> (Vec<c64>, Vec<c64>) {
 
 /// Every eigenvalue of `modes` is one of `full` (1e-10 of the largest |λ| of `modes`,
 /// the round-off of two eigensolvers), and they are the ones nearest `shift`.
-fn assert_nearest(full: &[c64], modes: &[c64], shift: f64, what: &str) {
-    let dist = |z: &c64| (z.re - shift).hypot(z.im);
+fn assert_nearest(full: &[c64], modes: &[c64], shift: c64, what: &str) {
+    let dist = |z: &c64| (z - shift).norm();
     let scale = modes.iter().map(|z| z.re.hypot(z.im)).fold(1.0, f64::max);
     for z in modes {
         let d = full.iter().map(|w| (w.re - z.re).hypot(w.im - z.im)).fold(f64::INFINITY, f64::min);
@@ -67,25 +67,28 @@ fn hanging_spatial_chain(n: usize) -> String {
 fn the_lowest_modes_of_hanging_chains_equal_the_full_route() {
     for (n, k) in [(2, 4), (12, 6), (40, 10)] {
         let model = load_str(&hanging_spatial_chain(n), "hang.xml").unwrap();
-        let (full, modes) = both_routes(&model, k, 0.0);
+        let (full, modes) = both_routes(&model, k, c64::ZERO);
         assert_eq!(modes.len(), k, "n = {n}");
-        assert_nearest(&full, &modes, 0.0, &format!("spatial chain n = {n}"));
+        assert_nearest(&full, &modes, c64::ZERO, &format!("spatial chain n = {n}"));
     }
+}
+
+/// The example model `models/{file}` with the parameters `set` changed.
+fn example_with(file: &str, set: &[(&str, f64)]) -> Model {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let m = load_file(&root.join("models").join(file)).unwrap();
+    let mut p = m.param_values();
+    for (k, par) in m.parameters.iter().enumerate() {
+        if let Some((_, v)) = set.iter().find(|(name, _)| *name == par.name) {
+            p[k] = *v;
+        }
+    }
+    m.with_params(&p).unwrap()
 }
 
 /// The double pendulum of the examples, at rest at absolute angles th1, th2.
 fn double_pendulum_at(th1: f64, th2: f64) -> Model {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let m = load_file(&root.join("models/double_pendulum.xml")).unwrap();
-    let mut p = m.param_values();
-    for (k, par) in m.parameters.iter().enumerate() {
-        match par.name.as_str() {
-            "th1" => p[k] = th1,
-            "th2" => p[k] = th2,
-            _ => {}
-        }
-    }
-    m.with_params(&p).unwrap()
+    example_with("double_pendulum.xml", &[("th1", th1), ("th2", th2)])
 }
 
 #[test]
@@ -96,9 +99,9 @@ fn a_shift_picks_the_eigenvalues_nearest_it() {
     let w = [(g * (3.0 - 6.0 / 7f64.sqrt())).sqrt(), (g * (3.0 + 6.0 / 7f64.sqrt())).sqrt()];
     let hanging = double_pendulum_at(0.0, 0.0);
     for k in [2, 4] {
-        let (full, modes) = both_routes(&hanging, k, 0.0);
+        let (full, modes) = both_routes(&hanging, k, c64::ZERO);
         assert_eq!(modes.len(), k);
-        assert_nearest(&full, &modes, 0.0, &format!("hanging, k = {k}"));
+        assert_nearest(&full, &modes, c64::ZERO, &format!("hanging, k = {k}"));
         for wk in &w[..k / 2] {
             assert!(
                 modes.iter().any(|z| z.re.abs() < 1e-9 * wk && (z.im.abs() - wk).abs() < 1e-9 * wk),
@@ -108,12 +111,43 @@ fn a_shift_picks_the_eigenvalues_nearest_it() {
     }
     let inverted = double_pendulum_at(std::f64::consts::PI, std::f64::consts::PI);
     for (shift, want) in [(6.0, [w[1], w[0]]), (-6.0, [-w[1], -w[0]]), (0.5, [w[0], -w[0]])] {
-        let (full, modes) = both_routes(&inverted, 2, shift);
-        assert_nearest(&full, &modes, shift, &format!("inverted, shift {shift}"));
+        let (full, modes) = both_routes(&inverted, 2, c64::new(shift, 0.0));
+        assert_nearest(&full, &modes, c64::new(shift, 0.0), &format!("inverted, shift {shift}"));
         for x in want {
             assert!(modes.iter().any(|z| z.im.abs() < 1e-9 * w[1] && (z.re - x).abs() < 1e-9 * w[1]), "{x}: {modes:?}");
         }
     }
+}
+
+#[test]
+fn a_complex_shift_picks_the_modes_nearest_a_frequency() {
+    // Double pendulum hanging (closed form above): σ = 1.1 ω₂ i selects +iω₂ alone, then
+    // +iω₁ (not the conjugates, farther from σ). 1e-9 relative, as above.
+    let g = 9.80665f64;
+    let w = [(g * (3.0 - 6.0 / 7f64.sqrt())).sqrt(), (g * (3.0 + 6.0 / 7f64.sqrt())).sqrt()];
+    let sigma = c64::new(0.0, 1.1 * w[1]);
+    let (full, modes) = both_routes(&double_pendulum_at(0.0, 0.0), 2, sigma);
+    assert_nearest(&full, &modes, sigma, "double pendulum, shift 1.1 w2 i");
+    for (z, wk) in modes.iter().zip([w[1], w[0]]) {
+        assert!(z.re.abs() < 1e-9 * wk && (z.im - wk).abs() < 1e-9 * wk, "{wk}: {modes:?}");
+    }
+    // The damped spring-mass of the examples at its equilibrium (x0 = 0): λ = −ζω_n ± iω_d
+    // = −1 ± 9.9498743710662i (the model's header); σ = 10i picks the upper one.
+    let smd = example_with("spring_mass_damper.xml", &[("x0", 0.0)]);
+    let (full, modes) = both_routes(&smd, 1, c64::new(0.0, 10.0));
+    assert_nearest(&full, &modes, c64::new(0.0, 10.0), "spring-mass-damper");
+    let exact = c64::new(-1.0, 9.9498743710662);
+    assert!((modes[0] - exact).norm() < 1e-9 * exact.norm(), "{modes:?}");
+    // In the middle of a spatial chain's spectrum: the 5 nearest of 80, equal to the full
+    // route's, on either side of the shift.
+    let chain = load_str(&hanging_spatial_chain(40), "hang.xml").unwrap();
+    let (full, _) = both_routes(&chain, 1, c64::ZERO);
+    let mut freqs: Vec<f64> = full.iter().map(|z| z.im).filter(|w| *w > 0.0).collect();
+    freqs.sort_by(f64::total_cmp);
+    let sigma = c64::new(0.0, 0.5 * (freqs[20] + freqs[21]) + 0.1 * (freqs[21] - freqs[20]));
+    let (full, modes) = both_routes(&chain, 5, sigma);
+    assert_eq!(modes.len(), 5);
+    assert_nearest(&full, &modes, sigma, "spatial chain n = 40, complex shift");
 }
 
 #[test]
@@ -151,15 +185,37 @@ fn the_cli_writes_the_modes_as_json_and_refuses_a_moving_point() {
         assert!(d < 1e-9 * z.1.abs().max(1.0), "{z:?}");
     }
     // Bad arguments: a usage error naming them, not an empty table or a NaN.
-    for bad in [
-        &["--modes", "0"][..],
-        &["--modes", "3", "--shift", "nan"][..],
-        &["--modes", "3", "--format", "npz", "-o", "x.npz"][..],
+    for (bad, named) in [
+        (&["--modes", "0"][..], "--modes"),
+        (&["--modes", "3", "--shift", "nan"][..], "--shift"),
+        (&["--modes", "3", "--shift", "1+nani"][..], "--shift"),
+        (&["--modes", "3", "--shift", "2+"][..], "--shift"),
+        (&["--modes", "3", "--format", "npz", "-o", "x.npz"][..], "--modes"),
     ] {
         let o = mbfmu(&[&["linearize", model.to_str().unwrap()][..], bad].concat());
         let err = String::from_utf8_lossy(&o.stderr);
-        assert!(!o.status.success() && err.contains("--modes"), "{bad:?}: {err}");
+        assert!(!o.status.success() && err.contains(named), "{bad:?}: {err}");
     }
+    // A complex shift through the CLI: the JSON names it, and the mode nearest it is the
+    // full route's.
+    let o = mbfmu(&[
+        "linearize",
+        model.to_str().unwrap(),
+        "--modes",
+        "1",
+        "--shift",
+        "0+30i",
+        "--format",
+        "json",
+        "-o",
+        json.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(pair(&v[0]["shift"]), (0.0, 30.0));
+    let z = pair(&v[0]["eigenvalues"][0]);
+    let nearest = all.iter().map(pair).min_by(|a, b| a.0.hypot(a.1 - 30.0).total_cmp(&b.0.hypot(b.1 - 30.0))).unwrap();
+    assert!((z.0 - nearest.0).hypot(z.1 - nearest.1) < 1e-9 * nearest.1.abs(), "{z:?} vs {nearest:?}");
     // Released from a swing pose the chain is not at an equilibrium: a clear refusal.
     let o = mbfmu(&["linearize", model.to_str().unwrap(), "--modes", "4", "--set", "j1.angle=0.5"]);
     let err = String::from_utf8_lossy(&o.stderr);
@@ -179,7 +235,7 @@ fn the_readme_arnoldi_counts_of_the_1000_link_chain_hold() {
     let mut sim = Simulator::new(&model, SimOptions { tol: 1e-8, max_step: None, ..Default::default() }, 0.0).unwrap();
     let (j, mass, f, mult) = sim.pencil().unwrap();
     assert!(equilibrium_residual(&f, &mass, &mult) < 1e-9);
-    let modes = shift_invert_modes(&j, &mass, f.len(), 10, 2000, 0.0).unwrap();
+    let modes = shift_invert_modes(&j, &mass, f.len(), 10, 2000, c64::ZERO).unwrap();
     assert_eq!(modes.eigenvalues.len(), 10);
     assert!(modes.eigenvalues.iter().all(|z| z.re.abs() < 1e-9 * z.im.abs()), "{:?}", modes.eigenvalues);
     assert!(modes.solves <= 2 * README_SOLVES, "{} solves", modes.solves);
