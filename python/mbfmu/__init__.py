@@ -6,6 +6,7 @@ the linearization of coupled systems of FMUs (SSP).
     lins = mbfmu.linearize("bicycle.fmu", at=[0, 1, 2])
     print(lins[0])                    # eigenvalue table
     sys = lins[0].to_control()        # control.StateSpace with names
+    low = mbfmu.eigenvalues("chain.xml", modes=10)   # the 10 lowest, without forming A
 """
 
 from .errors import ArgumentError, FMUCallError, FMUNotFoundError, MbfmuError, NotLinearizableError
@@ -13,6 +14,7 @@ from .files import load, save
 from .linearization import EigenRow, Linearization
 from .linearize_fmu import DifferencesWarning, linearize
 from .pack import PackWarning, pack
+from .spectrum import Spectrum, eigenvalues
 from .sweep import Sweep, sweep
 from .system import linearize_system
 
@@ -26,7 +28,9 @@ __all__ = [
     "MbfmuError",
     "NotLinearizableError",
     "PackWarning",
+    "Spectrum",
     "Sweep",
+    "eigenvalues",
     "linearize",
     "linearize_system",
     "load",

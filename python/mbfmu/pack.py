@@ -41,6 +41,31 @@ def cli() -> Path:
     )
 
 
+def set_args(start_values) -> list[str]:
+    """`--set name=value` arguments of the tool for {name: value}; ArgumentError for a
+    value that is not a number."""
+    args = []
+    for name, value in (start_values or {}).items():
+        try:
+            number = float(value)
+        except (TypeError, ValueError):
+            raise ArgumentError(f"start value of '{name}': {value!r} is not a number") from None
+        # repr of a float reads back exactly in the tool (Rust's f64 parser).
+        args += ["--set", f"{name}={number!r}"]
+    return args
+
+
+def run_cli(args: list[str], command: str) -> subprocess.CompletedProcess:
+    """Run the tool; its usage and model errors (exit 2) are ArgumentError with its
+    message, any other failure MbfmuError."""
+    r = subprocess.run(args, capture_output=True, text=True)
+    if r.returncode == 2:
+        raise ArgumentError(r.stderr.strip())
+    if r.returncode != 0:
+        raise MbfmuError(f"mbfmu {command} failed (exit {r.returncode}): {r.stderr.strip()}")
+    return r
+
+
 def pack(model, out=None, out_dir=None, start_values=None) -> Path:
     """Pack `model` (an mbfmu model file) into the FMU `out` (default: the model's name
     with .fmu beside it); `out_dir` also writes the unzipped FMU there. Returns `out`.
@@ -58,18 +83,7 @@ def pack(model, out=None, out_dir=None, start_values=None) -> Path:
     args = [str(cli()), "pack", str(model), "-o", str(out)]
     if out_dir is not None:
         args += ["--out-dir", str(out_dir)]
-    for name, value in (start_values or {}).items():
-        try:
-            number = float(value)
-        except (TypeError, ValueError):
-            raise ArgumentError(f"start value of '{name}': {value!r} is not a number") from None
-        # repr of a float reads back exactly in the tool (Rust's f64 parser).
-        args += ["--set", f"{name}={number!r}"]
-    r = subprocess.run(args, capture_output=True, text=True)
-    if r.returncode == 2:
-        raise ArgumentError(r.stderr.strip())
-    if r.returncode != 0:
-        raise MbfmuError(f"mbfmu pack failed (exit {r.returncode}): {r.stderr.strip()}")
+    r = run_cli([*args, *set_args(start_values)], "pack")
     for line in r.stderr.splitlines():
         if line.startswith("warning: "):
             warnings.warn(f"{model}: {line.removeprefix('warning: ')}", PackWarning, stacklevel=2)
