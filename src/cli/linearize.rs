@@ -328,11 +328,28 @@ pub fn print_selection(sel: &Selection, out: &mut dyn Write) -> std::io::Result<
     Ok(())
 }
 
-fn json_matrix(m: &faer::Mat<f64>) -> String {
-    let rows: Vec<String> = (0..m.nrows())
-        .map(|i| format!("[{}]", (0..m.ncols()).map(|j| format!("{:e}", m[(i, j)])).collect::<Vec<_>>().join(", ")))
-        .collect();
-    format!("[{}]", rows.join(", "))
+/// Append `m` as `[[a, b], [c, d]]` (numbers as `{:e}`) to `s`, without a string per
+/// entry: at N = 1000 links A alone has 4 million (mostly zero) entries.
+fn push_json_matrix(s: &mut String, m: &faer::Mat<f64>) {
+    use std::fmt::Write as _;
+    s.push('[');
+    for i in 0..m.nrows() {
+        s.push_str(if i == 0 { "[" } else { ", [" });
+        for j in 0..m.ncols() {
+            if j > 0 {
+                s.push_str(", ");
+            }
+            let v = m[(i, j)];
+            if v == 0.0 {
+                // What `{:e}` writes for ±0, without formatting.
+                s.push_str(if v.is_sign_negative() { "-0e0" } else { "0e0" });
+            } else {
+                let _ = write!(s, "{v:e}");
+            }
+        }
+        s.push(']');
+    }
+    s.push(']');
 }
 
 fn json_names(v: &[String]) -> String {
@@ -347,23 +364,24 @@ fn json_names(v: &[String]) -> String {
 
 /// The linearizations as a JSON array, each with its eigenvalues (`[[re, im], …]`).
 pub fn to_json(results: &[Linearization], eigs: &[Vec<c64>]) -> String {
-    let items: Vec<String> = results
-        .iter()
-        .zip(eigs)
-        .map(|(l, ev)| {
-            format!(
-                "{{\"time\": {:e}, \"states\": {}, \"inputs\": {}, \"outputs\": {}, \"A\": {}, \"B\": {}, \"C\": {}, \"D\": {}, \"eigenvalues\": {}}}",
-                l.time,
-                json_names(&l.states),
-                json_names(&l.inputs),
-                json_names(&l.outputs),
-                json_matrix(&l.a),
-                json_matrix(&l.b),
-                json_matrix(&l.c),
-                json_matrix(&l.d),
-                json_eigenvalues(ev)
-            )
-        })
-        .collect();
-    format!("[{}]", items.join(",\n"))
+    let mut s = String::from("[");
+    for (k, (l, ev)) in results.iter().zip(eigs).enumerate() {
+        if k > 0 {
+            s.push_str(",\n");
+        }
+        s.push_str(&format!(
+            "{{\"time\": {:e}, \"states\": {}, \"inputs\": {}, \"outputs\": {}",
+            l.time,
+            json_names(&l.states),
+            json_names(&l.inputs),
+            json_names(&l.outputs)
+        ));
+        for (name, m) in [("A", &l.a), ("B", &l.b), ("C", &l.c), ("D", &l.d)] {
+            s.push_str(&format!(", \"{name}\": "));
+            push_json_matrix(&mut s, m);
+        }
+        s.push_str(&format!(", \"eigenvalues\": {}}}", json_eigenvalues(ev)));
+    }
+    s.push(']');
+    s
 }
