@@ -13,7 +13,7 @@ use super::{CliError, SetArgs};
 use crate::dae::{BATCH_MAX_STEPS, SimOptions, Simulator};
 use crate::linearize::eigen::{eigenvalues, format_table, rows_of_eigenvalues};
 use crate::linearize::modes::{equilibrium_residual, format_shift, shift_invert_modes};
-use crate::linearize::{Linearization, Selection, linearize, selection_at_start, state_values};
+use crate::linearize::{Linearization, Selection, linearize, selection_at_start, state_counts, state_values};
 use crate::model::Model;
 use faer::c64;
 
@@ -77,20 +77,22 @@ pub fn run(args: &LinearizeArgs, out: &mut dyn Write, report: &mut dyn Write) ->
     let t0 = model.experiment.start.unwrap_or(0.0);
     let (tol, times) = settings(args, &model, t0)?;
     let (mut sim, table) = start(args, &mut model, tol, t0)?;
-    // The FMU's states: selected on their own configuration, not on this run's tolerance.
-    let sel = selection_at_start(&model)?;
     let json_stdout = args.format == "json" && args.out.is_none();
     let rep: &mut dyn Write = if json_stdout { &mut *report } else { &mut *out };
-    print_selection(&sel, rep).map_err(io_err)?;
-    if model.static_analysis {
-        print_equilibrium(&mut sim, &sel, t0, rep)?;
-    }
     if let Some(k) = args.modes {
-        let items = run_modes(args, k, &mut sim, table.as_ref(), &sel, &times, rep)?;
+        // The eigenvalues do not depend on which states are chosen: no selection (at
+        // 10 000 links it cost as much as the modes themselves), only their number.
+        let items = run_modes(args, k, &mut sim, table.as_ref(), &times, rep)?;
         if args.format == "json" {
             write_json(args, format!("[{}]", items.join(",\n")), out)?;
         }
         return Ok(());
+    }
+    // The FMU's states: selected on their own configuration, not on this run's tolerance.
+    let sel = selection_at_start(&model)?;
+    print_selection(&sel, rep).map_err(io_err)?;
+    if model.static_analysis {
+        print_equilibrium(&mut sim, &sel, t0, rep)?;
     }
     let mut results = Vec::new();
     let mut eigs = Vec::new();
@@ -110,7 +112,6 @@ fn run_modes(
     k: usize,
     sim: &mut Simulator,
     table: Option<&InputTable>,
-    sel: &Selection,
     times: &[f64],
     rep: &mut dyn Write,
 ) -> Result<Vec<String>, CliError> {
@@ -123,7 +124,14 @@ fn run_modes(
             args.format
         )));
     }
-    let finite = sel.states.len() + sel.velocities.len() + sim.system().nx;
+    let (s0, s1, nx) = state_counts(sim.system());
+    let finite = s0 + s1 + nx;
+    writeln!(
+        rep,
+        "{finite} states ({s0} positions, {s1} velocities, {nx} differential; the eigenvalues do not depend on \
+         which are chosen)"
+    )
+    .map_err(io_err)?;
     let mut items = Vec::new();
     for &t in times {
         super::input_csv::advance(sim, table, t)?;

@@ -35,6 +35,8 @@ pub use states::derivative_name;
 pub use structure::{Dependencies, ModelStructure};
 
 use crate::dae::{EngineError, Simulator};
+use crate::mechanics::System;
+use crate::mechanics::constraint_jacobian::IndependentRows;
 use crate::model::Model;
 use jets::jets;
 
@@ -45,6 +47,14 @@ pub fn selection_at_start(model: &Model) -> Result<Selection, EngineError> {
     let t0 = model.experiment.start.unwrap_or(0.0);
     let sim = Simulator::new(model, tolerances::selection_options(), t0)?;
     select_states(sim.system(), sim.q(), t0, &sim.inputs()).map_err(EngineError::Numeric)
+}
+
+/// The numbers of position, velocity and differential states any selection on `sys` has
+/// (s0 = n − independent constraint rows, s1 = s0 − non-holonomic rows, nx): the count of
+/// finite eigenvalues, without selecting them.
+pub fn state_counts(sys: &System) -> (usize, usize, usize) {
+    let s0 = sys.n() - IndependentRows::of(sys).count;
+    (s0, s0.saturating_sub(sys.mn), sys.nx)
 }
 
 /// What the FMU of a model carries of its linearization, decided once when it is packed.
