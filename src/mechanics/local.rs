@@ -155,6 +155,11 @@ impl<'a, T: Real> LocalCtx<'a, T> {
 
     /// Local index of global body `b`.
     pub fn local(&self, b: usize) -> usize {
+        // A context over all bodies in order (angle recording, whole-system passes) finds
+        // b at b: no search, which would make such a pass quadratic in the bodies.
+        if self.ids.get(b) == Some(&b) {
+            return b;
+        }
         self.ids.iter().position(|&x| x == b).expect("element touches body")
     }
 
