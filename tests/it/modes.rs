@@ -7,7 +7,7 @@ use faer::c64;
 use mbfmu::dae::{SimOptions, Simulator};
 use mbfmu::linearize::eigen::eigenvalues;
 use mbfmu::linearize::modes::{equilibrium_residual, shift_invert_modes};
-use mbfmu::linearize::{linearize, select_states};
+use mbfmu::linearize::{linearize, select_states, state_counts};
 use mbfmu::model::Model;
 use mbfmu::model::parse::{load_file, load_str};
 
@@ -240,4 +240,30 @@ fn the_readme_arnoldi_counts_of_the_1000_link_chain_hold() {
     assert!(modes.eigenvalues.iter().all(|z| z.re.abs() < 1e-9 * z.im.abs()), "{:?}", modes.eigenvalues);
     assert!(modes.solves <= 2 * README_SOLVES, "{} solves", modes.solves);
     assert!(modes.restarts <= README_RESTARTS + 1, "{} restarts", modes.restarts);
+}
+
+#[test]
+fn the_state_count_without_a_selection_is_the_selections() {
+    // `--modes` selects no states: s0 + s1 + nx comes from the constraint rank and the
+    // non-holonomic rows (linearize::state_counts). The selection of Eq. 33 counts them
+    // itself: equal on every example model (redundant rows: fourbar; non-holonomic:
+    // bicycle, sleigh, disc; user states: blade, PID cart; flexible bodies).
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models");
+    let mut files: Vec<_> = ["", "flexible"]
+        .iter()
+        .flat_map(|d| std::fs::read_dir(root.join(d)).unwrap().map(|e| e.unwrap().path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "xml"))
+        .collect();
+    files.sort();
+    let mut checked = 0;
+    for path in &files {
+        let model = load_file(path).unwrap();
+        let t0 = model.experiment.start.unwrap_or(0.0);
+        let sim = Simulator::new(&model, SimOptions::default(), t0).unwrap();
+        let sel = select_states(sim.system(), sim.q(), t0, &sim.inputs()).unwrap();
+        let want = (sel.states.len(), sel.velocities.len(), sim.system().nx);
+        assert_eq!(state_counts(sim.system()), want, "{}", path.display());
+        checked += 1;
+    }
+    assert!(checked >= 14, "{checked} models");
 }
