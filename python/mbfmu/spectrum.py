@@ -48,7 +48,8 @@ class Spectrum:
         return eigen_rows(ev)
 
     def __str__(self) -> str:
-        near = "" if self.shift is None else f" nearest {self.shift}"
+        z = self.shift
+        near = "" if z is None else f" nearest {z.real:g}" + (f"{z.imag:+g}i" if z.imag else "")
         head = f"t = {self.time}: {len(self.eigenvalues)} eigenvalues{near} ({self.route})"
         return head + "\n" + format_eigen_table(self.eigen_table())
 
