@@ -212,8 +212,8 @@ impl<T: LuScalar> SparseLu<T> {
 }
 
 impl SparseLu<f64> {
-    /// Solve A x = b for `ncols` right-hand sides without holding them all: `fill(j, b)`
-    /// writes column j into a zeroed b, `take(j, x)` keeps what is needed of its
+    /// Solve A x = b (Aᵀ x = b with `transpose`) for `ncols` right-hand sides without
+    /// holding them all: `fill(j, b)` writes column j into a zeroed b, `take(j, x)` keeps what is needed of its
     /// solution. Columns go in blocks of `SOLVE_BLOCK` over `threads` threads (each
     /// with its own block and scratch; the factorization is shared read-only), so the
     /// memory is threads·dim·SOLVE_BLOCK. None if a solution is not finite (singular).
@@ -221,6 +221,7 @@ impl SparseLu<f64> {
         &self,
         ncols: usize,
         threads: usize,
+        transpose: bool,
         fill: impl Fn(usize, &mut [f64]) + Sync,
         take: impl Fn(usize, &[f64]) -> T + Sync,
     ) -> Option<Vec<T>> {
@@ -230,7 +231,12 @@ impl SparseLu<f64> {
             let mut out = Vec::with_capacity(cols.len());
             let width = SOLVE_BLOCK.min(cols.len());
             let mut block = Mat::<f64>::zeros(dim, width);
-            let mut buf = MemBuffer::new(s.lu.solve_in_place_scratch::<f64>(width, Par::Seq));
+            let req = if transpose {
+                s.lu.solve_transpose_in_place_scratch::<f64>(width, Par::Seq)
+            } else {
+                s.lu.solve_in_place_scratch::<f64>(width, Par::Seq)
+            };
+            let mut buf = MemBuffer::new(req);
             for start in cols.clone().step_by(SOLVE_BLOCK) {
                 let w = SOLVE_BLOCK.min(cols.end - start);
                 let mut b = block.as_mut().subcols_mut(0, w);
@@ -239,12 +245,13 @@ impl SparseLu<f64> {
                     col.fill(0.0);
                     fill(start + j, col);
                 }
-                LuRef::new_unchecked(&s.lu, numeric).solve_in_place_with_conj(
-                    Conj::No,
-                    b.rb_mut(),
-                    Par::Seq,
-                    MemStack::new(&mut buf),
-                );
+                let lu = LuRef::new_unchecked(&s.lu, numeric);
+                let stack = MemStack::new(&mut buf);
+                if transpose {
+                    lu.solve_transpose_in_place_with_conj(Conj::No, b.rb_mut(), Par::Seq, stack);
+                } else {
+                    lu.solve_in_place_with_conj(Conj::No, b.rb_mut(), Par::Seq, stack);
+                }
                 for j in 0..w {
                     let x = b.rb().col(j).try_as_col_major().expect("contiguous column").as_slice();
                     if x.iter().any(|v| !v.is_finite()) {

@@ -48,8 +48,31 @@ fn singular(p: &OperatingPoint) -> EngineError {
     ))
 }
 
+/// How the factored Eq. 34 yields A, B, C, D.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Route {
+    /// Whichever of the two needs fewer solves (the default).
+    Auto,
+    /// One solve per column of [A B; C D] (per state and per input): K x = R_c.
+    Columns,
+    /// One solve of the transposed system Kᵀ z = g per row of [A B; C D] that is not
+    /// exact (Ẇ, Ẋ, an Ṡ without its W; an output once for the state columns and once
+    /// for the input columns): the row is then zᵀ R_c for every column c at once.
+    Rows,
+}
+
 /// Linearize the simulation at its current point in the states of `sel` (Eq. 34, 36).
 pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result<Linearization, EngineError> {
+    linearize_with(sim, sel, threads, Route::Auto)
+}
+
+/// [`linearize`] by the given route (both give the same matrices to round-off).
+pub fn linearize_with(
+    sim: &mut Simulator,
+    sel: &Selection,
+    threads: usize,
+    route: Route,
+) -> Result<Linearization, EngineError> {
     let (udot, lam) = sim.accelerations()?;
     let (t, ext) = (sim.time(), sim.ext_with(&lam));
     let (q, u) = (sim.q().to_vec(), sim.u().to_vec());
@@ -64,8 +87,82 @@ pub fn linearize(sim: &mut Simulator, sel: &Selection, threads: usize) -> Result
     let sens = Sensitivities::of(&p);
     let mut lu = SparseLu::new();
     lu.factor(eq.dim(), &k).map_err(|_| singular(&p))?;
-    let fill = |col: usize, b: &mut [f64]| rhs.fill(rhs.column(col), b);
-    let take = |col: usize, x: &[f64]| sens.keep(rhs.column(col), x);
-    let sol = lu.solve_columns(eq.ns() + p.ni(), threads, fill, take).ok_or_else(|| singular(&p))?;
-    extract(&p, &sens, &sol, values)
+    let ncols = eq.ns() + p.ni();
+    let jobs = row_jobs(&p, &sens);
+    let by_rows = match route {
+        Route::Auto => jobs.len() < ncols,
+        Route::Columns => false,
+        Route::Rows => true,
+    };
+    let sol = if by_rows {
+        solve_by_rows(&p, &lu, &rhs, &sens, &jobs, threads)
+    } else {
+        let fill = |col: usize, b: &mut [f64]| rhs.fill(rhs.column(col), b);
+        let take = |col: usize, x: &[f64]| sens.keep(rhs.column(col), x);
+        lu.solve_columns(ncols, threads, false, fill, take)
+    };
+    extract(&p, &sens, &sol.ok_or_else(|| singular(&p))?, values)
+}
+
+/// A row of [A B; C D] to solve for by the transposed system: kept row `r`
+/// ([`Sensitivities::keep`]'s order) for the state columns, the input columns, or both.
+#[derive(Clone, Copy, Debug)]
+struct RowJob {
+    r: usize,
+    states: bool,
+    inputs: bool,
+}
+
+/// The rows the transposed route solves for: every kept row but the Ṡ rows that
+/// `extract` sets exactly (Ṡ = W); an output's functional differs between state and
+/// input columns, so each kind with columns is a job of its own.
+fn row_jobs(p: &OperatingPoint, sens: &Sensitivities) -> Vec<RowJob> {
+    let (s0, ns, ni) = (p.eq.s0, p.eq.ns(), p.ni());
+    let mut jobs: Vec<RowJob> = (0..ns)
+        .filter(|&r| r >= s0 || p.sel.velocity_of_state(r).is_none())
+        .map(|r| RowJob { r, states: true, inputs: true })
+        .collect();
+    for o in 0..sens.outputs() {
+        if ns > 0 {
+            jobs.push(RowJob { r: ns + o, states: true, inputs: false });
+        }
+        if ni > 0 {
+            jobs.push(RowJob { r: ns + o, states: false, inputs: true });
+        }
+    }
+    jobs
+}
+
+/// The kept values of every column (as the column route's `take` returns them), from one
+/// transposed solve per job; rows without a job stay 0 (`extract` sets them), a row
+/// whose functional is not finite is NaN.
+fn solve_by_rows(
+    p: &OperatingPoint,
+    lu: &SparseLu,
+    rhs: &RightHandSides,
+    sens: &Sensitivities,
+    jobs: &[RowJob],
+    threads: usize,
+) -> Option<Vec<Vec<f64>>> {
+    let (ns, ncols) = (p.eq.ns(), p.eq.ns() + p.ni());
+    let columns = |job: RowJob| (0..ncols).filter(move |&c| if c < ns { job.states } else { job.inputs });
+    let fill = |j: usize, g: &mut [f64]| {
+        let job = &jobs[j];
+        if sens.row_finite(job.r, job.states) {
+            sens.functional(job.r, job.states, g);
+        }
+    };
+    let take = |j: usize, z: &[f64]| -> Vec<f64> {
+        let job = jobs[j];
+        let finite = sens.row_finite(job.r, job.states);
+        columns(job).map(|c| if finite { rhs.apply(rhs.column(c), z) } else { f64::NAN }).collect()
+    };
+    let rows = lu.solve_columns(jobs.len(), threads, true, fill, take)?;
+    let mut sol = vec![vec![0.0; ns + sens.outputs()]; ncols];
+    for (job, row) in jobs.iter().zip(&rows) {
+        for (c, v) in columns(*job).zip(row) {
+            sol[c][job.r] = *v;
+        }
+    }
+    Some(sol)
 }

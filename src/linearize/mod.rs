@@ -25,7 +25,7 @@ pub mod structure;
 pub mod tiers;
 pub mod tolerances;
 
-pub use augmented::linearize;
+pub use augmented::{Route, linearize, linearize_with};
 pub use candidates::Candidates;
 pub use layout::{StateInfo, StateLayout, selection_by_name};
 pub use linearization::Linearization;

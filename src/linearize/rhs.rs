@@ -81,6 +81,17 @@ impl RightHandSides {
         }
     }
 
+    /// Right-hand side `col` applied to `z` (its dot product with `z`): a solution of
+    /// the transposed system for a kept row gives that row's entry of every column so.
+    pub fn apply(&self, col: Column, z: &[f64]) -> f64 {
+        match col {
+            Column::S(i) => z[self.eq.row_at(Equation::Eq34k, i)],
+            Column::W(i) => z[self.eq.row_at(Equation::Eq34j, i)],
+            Column::X(i) => z[self.eq.row_at(Equation::XBar, i)],
+            Column::Input(v) => self.by_input[v].iter().map(|&(r, val)| val * z[r]).sum(),
+        }
+    }
+
     /// Write right-hand side `col` into the zeroed `b`.
     pub fn fill(&self, col: Column, b: &mut [f64]) {
         match col {

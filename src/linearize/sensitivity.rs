@@ -60,43 +60,85 @@ impl Sensitivities {
     /// the inputs (`kinematic` false), so input columns take no q and u terms: they are
     /// zero and would carry only the LU's round-off.
     fn sensitivity(&self, g: &OutputGradient, x: &[f64], kinematic: bool) -> f64 {
+        let mut v = 0.0;
+        self.coefficients(g, kinematic, &mut |at, w| v += w * at.map_or(0.0, |i| x[i]));
+        v
+    }
+
+    /// The output sensitivity as a linear functional of the solution: calls `f(unknown,
+    /// weight)` for each of its terms, `None` for a term that is zero in this column kind
+    /// (its weight still counts: a non-finite one makes the derivative non-finite).
+    fn coefficients(&self, g: &OutputGradient, kinematic: bool, f: &mut dyn FnMut(Option<usize>, f64)) {
         let eq = &self.eq;
         let nql = g.cols.len();
-        let mut v = 0.0;
         for (a, &gi) in g.cols.iter().enumerate() {
             if kinematic {
-                v += g.dz[a] * x[eq.at(Unknown::Q, gi)] + g.dz[nql + a] * x[eq.at(Unknown::U, gi)];
+                f(Some(eq.at(Unknown::Q, gi)), g.dz[a]);
+                f(Some(eq.at(Unknown::U, gi)), g.dz[nql + a]);
             }
-            v += g.dz[2 * nql + a] * x[eq.at(Unknown::UDot, gi)];
+            f(Some(eq.at(Unknown::UDot, gi)), g.dz[2 * nql + a]);
         }
         for &(row, w) in &g.dlam {
-            v += w * x[eq.at(Unknown::Lambda, row)];
+            f(Some(eq.at(Unknown::Lambda, row)), w);
         }
         for (e, &dy) in g.dv.iter().enumerate().skip(self.xl.ni) {
             if dy == 0.0 {
                 continue;
             }
             match self.xl.entry(e) {
-                ExtEntry::Z(i) => v += dy * x[eq.at(Unknown::Z, i)],
+                ExtEntry::Z(i) => f(Some(eq.at(Unknown::Z, i)), dy),
                 ExtEntry::Load(k, c) => {
                     let Some(lg) = self.loads[k].as_ref() else { continue };
-                    lg.terms(c, |term, d| v += dy * d * self.term(term, x, kinematic));
+                    lg.terms(c, |term, d| f(self.term(term, kinematic), dy * d));
                 }
                 ExtEntry::Input(_) => unreachable!("inputs are skipped"),
             }
         }
-        v
     }
 
-    /// The solution's entry for one term of a load gradient.
-    fn term(&self, term: LoadTerm, x: &[f64], kinematic: bool) -> f64 {
+    /// The unknown of one term of a load gradient (None: zero in this column kind).
+    fn term(&self, term: LoadTerm, kinematic: bool) -> Option<usize> {
         let eq = &self.eq;
         match term {
-            LoadTerm::Q(i) if kinematic => x[eq.at(Unknown::Q, i)],
-            LoadTerm::U(i) if kinematic => x[eq.at(Unknown::U, i)],
-            LoadTerm::Lam(r) => x[eq.at(Unknown::Lambda, r)],
-            LoadTerm::Ext(e) if self.xl.z_range().contains(&e) => x[eq.at(Unknown::Z, e - self.xl.ni)],
-            _ => 0.0,
+            LoadTerm::Q(i) if kinematic => Some(eq.at(Unknown::Q, i)),
+            LoadTerm::U(i) if kinematic => Some(eq.at(Unknown::U, i)),
+            LoadTerm::Lam(r) => Some(eq.at(Unknown::Lambda, r)),
+            LoadTerm::Ext(e) if self.xl.z_range().contains(&e) => Some(eq.at(Unknown::Z, e - self.xl.ni)),
+            _ => None,
         }
+    }
+
+    /// The functional that gives kept row `r` (as [`Sensitivities::keep`] orders them:
+    /// Ṡ, Ẇ, Ẋ, outputs) of a solution of a column of kind `kinematic`, as a dense vector
+    /// over the unknowns: the right-hand side of the transposed Eq. 34 that yields that
+    /// row for every column at once. Only for a row whose weights are finite
+    /// ([`Sensitivities::row_finite`]).
+    pub fn functional(&self, r: usize, kinematic: bool, g: &mut [f64]) {
+        let eq = &self.eq;
+        let (s0, s1, nx) = (eq.s0, eq.s1, eq.nx);
+        if r < s0 {
+            g[eq.at(Unknown::SDot, r)] = 1.0;
+        } else if r < s0 + s1 {
+            g[eq.at(Unknown::WDot, r - s0)] = 1.0;
+        } else if r < s0 + s1 + nx {
+            g[eq.col(Unknown::Z) + nx + (r - s0 - s1)] = 1.0; // Z = (X, Ẋ, V, a)
+        } else {
+            self.coefficients(&self.grads[r - s0 - s1 - nx], kinematic, &mut |at, w| {
+                if let Some(i) = at {
+                    g[i] += w;
+                }
+            });
+        }
+    }
+
+    /// Whether every weight of kept row `r`'s functional is finite (else that row of C or
+    /// D is not finite, whatever the solution).
+    pub fn row_finite(&self, r: usize, kinematic: bool) -> bool {
+        let ns = self.eq.ns();
+        let mut finite = true;
+        if r >= ns {
+            self.coefficients(&self.grads[r - ns], kinematic, &mut |_, w| finite &= w.is_finite());
+        }
+        finite
     }
 }

@@ -79,7 +79,7 @@ const ELEMENTS: [(&str, ElementRef); 9] = [
 ];
 
 /// The mechanism after 0.3 s of motion (a moving, non-equilibrium point).
-fn moving() -> Simulator {
+pub(crate) fn moving() -> Simulator {
     let m = load_str(MECH, "loads.xml").unwrap_or_else(|e| panic!("{e}"));
     let mut sim = Simulator::new(&m, SimOptions { tol: 1e-10, max_step: None, ..Default::default() }, 0.0).unwrap();
     sim.advance(0.3).unwrap();

@@ -34,6 +34,7 @@ mod fmi_sequences;
 mod jacobians;
 mod linearize;
 mod linearize_loads;
+mod linearize_routes;
 mod linearize_seed;
 mod malformed;
 mod memory_valgrind;

@@ -37,7 +37,7 @@ fn block_solves_over_threads_match_single_solves() {
     lu.factor(n, &t).unwrap();
     let ncols = 53; // several blocks, a partial last one
     for threads in [1, 2, 3] {
-        let sol = lu.solve_columns(ncols, threads, rhs, |j, x| (j, x.to_vec())).unwrap();
+        let sol = lu.solve_columns(ncols, threads, false, rhs, |j, x| (j, x.to_vec())).unwrap();
         assert_eq!(sol.len(), ncols);
         for (k, (j, x)) in sol.iter().enumerate() {
             assert_eq!(k, *j, "columns in order");
@@ -70,5 +70,5 @@ fn singular_matrix_gives_none() {
     t.push(2, 3, 1.0);
     let mut lu = SparseLu::new();
     lu.factor(4, &t).unwrap();
-    assert!(lu.solve_columns(3, 2, |j, b| b[j + 1] = 1.0, |_, x| x.to_vec()).is_none());
+    assert!(lu.solve_columns(3, 2, false, |j, b| b[j + 1] = 1.0, |_, x| x.to_vec()).is_none());
 }
