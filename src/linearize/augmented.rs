@@ -101,7 +101,8 @@ pub fn linearize_with(
         let take = |col: usize, x: &[f64]| sens.keep(rhs.column(col), x);
         lu.solve_columns(ncols, threads, false, fill, take)
     };
-    extract(&p, &sens, &sol.ok_or_else(|| singular(&p))?, values)
+    let solves = if by_rows { jobs.len() } else { ncols };
+    extract(&p, &sens, &sol.ok_or_else(|| singular(&p))?, values, solves)
 }
 
 /// A row of [A B; C D] to solve for by the transposed system: kept row `r`

@@ -15,6 +15,7 @@ pub(super) fn extract(
     sens: &Sensitivities,
     sol: &[Vec<f64>],
     values: Vec<f64>,
+    solves: usize,
 ) -> Result<Linearization, EngineError> {
     let (sys, ns, ni, no) = (p.sys, p.eq.ns(), p.ni(), sens.outputs());
     let mut a = Mat::from_fn(ns, ns, |r, c| sol[c][r]);
@@ -37,7 +38,7 @@ pub(super) fn extract(
     states.extend(p.sel.velocities.iter().map(|w| w.name()));
     states.extend(sys.user.iter().take(p.eq.nx).map(|u| u.name.clone()));
     let (inputs, outputs) = (sys.input_names.clone(), sys.output_names.clone());
-    Ok(Linearization { time: p.t, states, inputs, outputs, a, b, c, d, x })
+    Ok(Linearization { time: p.t, states, inputs, outputs, a, b, c, d, x, solves })
 }
 
 /// Where W_j = Ṡ_k (always without non-holonomic constraints), row k of A and B is

@@ -24,4 +24,8 @@ pub struct Linearization {
     pub d: Mat<f64>,
     /// Values of the states (S, W, X) at the operating point.
     pub x: Vec<f64>,
+    /// Systems solved with Eq. 34's LU: one per column of [A B] (states and inputs), or
+    /// one per row of [A B; C D] that is not exact (the transposed route), whichever is
+    /// fewer.
+    pub solves: usize,
 }

@@ -41,7 +41,7 @@ fn assert_nearest(full: &[c64], modes: &[c64], shift: c64, what: &str) {
 
 /// An n-link spatial chain hanging straight down at rest: links along −z, revolute axes
 /// alternating x and y (`bench/chain.sh`'s chain in its rest pose).
-fn hanging_spatial_chain(n: usize) -> String {
+pub(crate) fn hanging_spatial_chain(n: usize) -> String {
     let (l, m) = (0.1, 0.1);
     let i = m * l * l / 12.0;
     let mut s = String::from(
