@@ -35,21 +35,9 @@ for a in "$@"; do
 done
 [ ${#sizes[@]} -gt 0 ] || sizes=(10 300 1000)
 
-if [ -n "${MBFMU_BIN:-}" ]; then
-    bin="$MBFMU_BIN"
-else
-    cargo build --release --quiet
-    bin="${CARGO_TARGET_DIR:-target}/release/mbfmu"
-fi
-bin="$(cd "$(dirname "$bin")" && pwd)/$(basename "$bin")"
-
-venv="$here/.venv"
-py="$venv/bin/python"
-if ! "$py" -c 'import exudyn, numpy, scipy' 2>/dev/null; then
-    python3 -m venv "$venv"
-    "$py" -m pip install --quiet --upgrade pip
-    "$py" -m pip install --quiet exudyn numpy scipy
-fi
+# shellcheck source=bench/peers/setup.sh
+. "$here/setup.sh"
+peers_setup "exudyn, numpy, scipy" exudyn numpy scipy
 echo "$(date)"
 echo "mbfmu: $bin ($(git log -1 --format='%h %cd' --date=short))"
 

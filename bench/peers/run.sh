@@ -33,21 +33,9 @@ for a in "$@"; do
 done
 [ ${#sizes[@]} -gt 0 ] || sizes=(10 100 300)
 
-if [ -n "${MBFMU_BIN:-}" ]; then
-    bin="$MBFMU_BIN"
-else
-    cargo build --release --quiet
-    bin="${CARGO_TARGET_DIR:-target}/release/mbfmu"
-fi
-bin="$(cd "$(dirname "$bin")" && pwd)/$(basename "$bin")"
-
-venv="$here/.venv"
-py="$venv/bin/python"
-if ! "$py" -c 'import exudyn, mujoco, fmpy, numpy, matplotlib' 2>/dev/null; then
-    python3 -m venv "$venv"
-    "$py" -m pip install --quiet --upgrade pip
-    "$py" -m pip install --quiet exudyn mujoco fmpy numpy matplotlib
-fi
+# shellcheck source=bench/peers/setup.sh
+. "$here/setup.sh"
+peers_setup "exudyn, mujoco, fmpy, numpy, matplotlib" exudyn mujoco fmpy numpy matplotlib
 "$py" - <<'PY'
 import exudyn, fmpy, mujoco, numpy
 print(f"peers: exudyn {exudyn.__version__}, mujoco {mujoco.__version__}, fmpy {fmpy.__version__}, numpy {numpy.__version__}")

@@ -205,8 +205,11 @@ fn parse_shift(text: &str) -> Result<c64, String> {
     let b = body.as_bytes();
     let split = (1..b.len()).rev().find(|&i| matches!(b[i], b'+' | b'-') && !matches!(b[i - 1], b'e' | b'E'));
     match split {
-        Some(i) if body[..i].parse::<f64>().is_ok() => Ok(c64::new(num(&body[..i])?, num(&body[i..])?)),
-        Some(_) => Err(bad()),
+        // The real part is a number in full (`num`'s lone signs stand for ±1 only in front of i).
+        Some(i) => match body[..i].parse::<f64>() {
+            Ok(re) if re.is_finite() => Ok(c64::new(re, num(&body[i..])?)),
+            _ => Err(bad()),
+        },
         None => Ok(c64::new(0.0, num(body)?)),
     }
 }

@@ -34,10 +34,10 @@ impl Triplets {
         self.idx.clear();
         self.vals.clear();
     }
-    /// y += A x.
-    pub fn mul_add(&self, x: &[f64], y: &mut [f64]) {
+    /// y += A x (x and y real or complex).
+    pub fn mul_add<T: Copy + std::ops::AddAssign + std::ops::Mul<f64, Output = T>>(&self, x: &[T], y: &mut [T]) {
         for (p, v) in self.idx.iter().zip(&self.vals) {
-            y[p.row] += v * x[p.col];
+            y[p.row] += x[p.col] * *v;
         }
     }
 }

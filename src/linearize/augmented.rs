@@ -112,6 +112,8 @@ struct RowJob {
     r: usize,
     states: bool,
     inputs: bool,
+    /// Whether the row's functional has finite weights (else the row is NaN, unsolved).
+    finite: bool,
 }
 
 /// The rows the transposed route solves for: every kept row but the Ṡ rows that
@@ -121,14 +123,14 @@ fn row_jobs(p: &OperatingPoint, sens: &Sensitivities) -> Vec<RowJob> {
     let (s0, ns, ni) = (p.eq.s0, p.eq.ns(), p.ni());
     let mut jobs: Vec<RowJob> = (0..ns)
         .filter(|&r| r >= s0 || p.sel.velocity_of_state(r).is_none())
-        .map(|r| RowJob { r, states: true, inputs: true })
+        .map(|r| RowJob { r, states: true, inputs: true, finite: true })
         .collect();
     for o in 0..sens.outputs() {
-        if ns > 0 {
-            jobs.push(RowJob { r: ns + o, states: true, inputs: false });
-        }
-        if ni > 0 {
-            jobs.push(RowJob { r: ns + o, states: false, inputs: true });
+        for (states, wanted) in [(true, ns > 0), (false, ni > 0)] {
+            if wanted {
+                let finite = sens.row_finite(ns + o, states);
+                jobs.push(RowJob { r: ns + o, states, inputs: !states, finite });
+            }
         }
     }
     jobs
@@ -149,14 +151,13 @@ fn solve_by_rows(
     let columns = |job: RowJob| (0..ncols).filter(move |&c| if c < ns { job.states } else { job.inputs });
     let fill = |j: usize, g: &mut [f64]| {
         let job = &jobs[j];
-        if sens.row_finite(job.r, job.states) {
+        if job.finite {
             sens.functional(job.r, job.states, g);
         }
     };
     let take = |j: usize, z: &[f64]| -> Vec<f64> {
         let job = jobs[j];
-        let finite = sens.row_finite(job.r, job.states);
-        columns(job).map(|c| if finite { rhs.apply(rhs.column(c), z) } else { f64::NAN }).collect()
+        columns(job).map(|c| if job.finite { rhs.apply(rhs.column(c), z) } else { f64::NAN }).collect()
     };
     let rows = lu.solve_columns(jobs.len(), threads, true, fill, take)?;
     let mut sol = vec![vec![0.0; ns + sens.outputs()]; ncols];

@@ -99,6 +99,7 @@ trait Scalar:
     + Add<Output = Self>
     + Sub<Output = Self>
     + Mul<Output = Self>
+    + Mul<f64, Output = Self>
     + SubAssign
 {
     /// Whether the arithmetic is real (then conjugate pairs are kept together).
@@ -204,9 +205,7 @@ struct Operator<'a, T: Scalar> {
 impl<T: Scalar> Operator<'_, T> {
     fn apply(&mut self, v: &[T], out: &mut [T]) -> Result<(), String> {
         self.tmp.fill(T::zero());
-        for (p, mv) in self.m.idx.iter().zip(&self.m.vals) {
-            self.tmp[p.row] += T::re(*mv) * v[p.col];
-        }
+        self.m.mul_add(v, &mut self.tmp);
         if !self.lu.solve(&mut self.tmp) {
             return Err("shift-invert solve failed".into());
         }

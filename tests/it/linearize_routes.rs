@@ -5,6 +5,7 @@
 //! solves. (Each route is checked against independent references through the other
 //! linearization tests: these run the automatic route.)
 
+use crate::common::{model, model_files};
 use mbfmu::dae::{SimOptions, Simulator};
 use mbfmu::linearize::{Linearization, Route, linearize_with, select_states};
 use mbfmu::model::parse::{load_file, load_str};
@@ -39,14 +40,7 @@ fn both(sim: &mut Simulator) -> f64 {
 fn rows_and_columns_give_the_same_linearization() {
     // 1e-10: the two solve different triangular systems with one LU; their round-off
     // is cond(K)·ε, with K's condition numbers here below 1e5.
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models");
-    let mut files: Vec<_> = ["", "flexible"]
-        .iter()
-        .flat_map(|d| std::fs::read_dir(root.join(d)).unwrap().map(|e| e.unwrap().path()))
-        .filter(|p| p.extension().is_some_and(|e| e == "xml"))
-        .collect();
-    files.sort();
-    for path in &files {
+    for path in &model_files() {
         let model = load_file(path).unwrap();
         let t0 = model.experiment.start.unwrap_or(0.0);
         let mut sim =
@@ -67,15 +61,14 @@ fn the_hanging_chain_takes_one_solve_per_velocity_state() {
     // README, Benchmark: on the 1000-link chain Eq. 34 is solved by rows, 1000 solves (the
     // Ẇ rows; Ṡ = W is exact) instead of 2000 by columns. Counted, not timed; both routes
     // agree (above), so the automatic choice only changes the work.
-    let model = load_str(&crate::modes::hanging_spatial_chain(1000), "hang.xml").unwrap();
-    let mut sim = Simulator::new(&model, SimOptions { tol: 1e-8, max_step: None, ..Default::default() }, 0.0).unwrap();
+    let chain = load_str(&crate::modes::hanging_spatial_chain(1000), "hang.xml").unwrap();
+    let mut sim = Simulator::new(&chain, SimOptions { tol: 1e-8, max_step: None, ..Default::default() }, 0.0).unwrap();
     let sel = select_states(sim.system(), sim.q(), 0.0, &sim.inputs()).unwrap();
     let lin = linearize_with(&mut sim, &sel, 2, Route::Auto).unwrap();
     assert_eq!((sel.states.len(), lin.solves), (1000, 1000));
     // A small model with outputs keeps the column route: the pendulum has 2 states and
     // no inputs, and more output rows than that.
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models");
-    let pendulum = load_file(&root.join("pendulum.xml")).unwrap();
+    let pendulum = model("pendulum.xml");
     let mut sim = Simulator::new(&pendulum, SimOptions::default(), 0.0).unwrap();
     let sel = select_states(sim.system(), sim.q(), 0.0, &sim.inputs()).unwrap();
     let lin = linearize_with(&mut sim, &sel, 2, Route::Auto).unwrap();

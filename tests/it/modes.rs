@@ -2,7 +2,7 @@
 //! pencil of the DAE, against the closed form of a hanging rod chain and against the full
 //! route (dense A of Eq. 36) on spatial chains and the example models at equilibria.
 
-use crate::common::mbfmu;
+use crate::common::{mbfmu, model, model_files};
 use faer::c64;
 use mbfmu::dae::{SimOptions, Simulator};
 use mbfmu::linearize::eigen::eigenvalues;
@@ -75,8 +75,7 @@ fn the_lowest_modes_of_hanging_chains_equal_the_full_route() {
 
 /// The example model `models/{file}` with the parameters `set` changed.
 fn example_with(file: &str, set: &[(&str, f64)]) -> Model {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let m = load_file(&root.join("models").join(file)).unwrap();
+    let m = model(file);
     let mut p = m.param_values();
     for (k, par) in m.parameters.iter().enumerate() {
         if let Some((_, v)) = set.iter().find(|(name, _)| *name == par.name) {
@@ -156,19 +155,16 @@ fn the_cli_writes_the_modes_as_json_and_refuses_a_moving_point() {
     std::fs::create_dir_all(&dir).unwrap();
     let model = dir.join("hang.xml");
     std::fs::write(&model, hanging_spatial_chain(20)).unwrap();
-    let json = dir.join("modes.json");
-    let o = mbfmu(&[
-        "linearize",
-        model.to_str().unwrap(),
-        "--modes",
-        "6",
-        "--format",
-        "json",
-        "-o",
-        json.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    // `mbfmu linearize MODEL --modes K [--shift S] --format json`, parsed.
+    let modes_json = |extra: &[&str]| -> serde_json::Value {
+        let json = dir.join("modes.json");
+        let args =
+            [&["linearize", model.to_str().unwrap()][..], extra, &["--format", "json", "-o", json.to_str().unwrap()]];
+        let o = mbfmu(&args.concat());
+        assert!(o.status.success(), "{extra:?}: {}", String::from_utf8_lossy(&o.stderr));
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap()
+    };
+    let v = modes_json(&["--modes", "6"]);
     let ev = v[0]["eigenvalues"].as_array().unwrap();
     assert_eq!(ev.len(), 6);
     assert_eq!(v[0]["route"], "shift-invert");
@@ -198,20 +194,7 @@ fn the_cli_writes_the_modes_as_json_and_refuses_a_moving_point() {
     }
     // A complex shift through the CLI: the JSON names it, and the mode nearest it is the
     // full route's.
-    let o = mbfmu(&[
-        "linearize",
-        model.to_str().unwrap(),
-        "--modes",
-        "1",
-        "--shift",
-        "0+30i",
-        "--format",
-        "json",
-        "-o",
-        json.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let v = modes_json(&["--modes", "1", "--shift", "0+30i"]);
     assert_eq!(pair(&v[0]["shift"]), (0.0, 30.0));
     let z = pair(&v[0]["eigenvalues"][0]);
     let nearest = all.iter().map(pair).min_by(|a, b| a.0.hypot(a.1 - 30.0).total_cmp(&b.0.hypot(b.1 - 30.0))).unwrap();
@@ -248,15 +231,8 @@ fn the_state_count_without_a_selection_is_the_selections() {
     // non-holonomic rows (linearize::state_counts). The selection of Eq. 33 counts them
     // itself: equal on every example model (redundant rows: fourbar; non-holonomic:
     // bicycle, sleigh, disc; user states: blade, PID cart; flexible bodies).
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models");
-    let mut files: Vec<_> = ["", "flexible"]
-        .iter()
-        .flat_map(|d| std::fs::read_dir(root.join(d)).unwrap().map(|e| e.unwrap().path()))
-        .filter(|p| p.extension().is_some_and(|e| e == "xml"))
-        .collect();
-    files.sort();
     let mut checked = 0;
-    for path in &files {
+    for path in &model_files() {
         let model = load_file(path).unwrap();
         let t0 = model.experiment.start.unwrap_or(0.0);
         let sim = Simulator::new(&model, SimOptions::default(), t0).unwrap();
