@@ -12,3 +12,4 @@ pub mod linearize;
 pub mod mechanics;
 pub mod modal;
 pub mod model;
+pub mod pack;

@@ -1,5 +1,5 @@
 //! `mbfmu install [--prefix DIR]`: install this `mbfmu` as one self-contained executable,
-//! `DIR/bin/mbfmu`, with the FMU library embedded ([`crate::fmi::bundle`]), so that
+//! `DIR/bin/mbfmu`, with the FMU library embedded ([`crate::pack::bundle`]), so that
 //! `mbfmu pack` works from any directory, for any user, with no environment variable.
 
 use std::io::Write;
@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 use clap::Args;
 
 use super::CliError;
-use crate::fmi::bundle::{bundled, image};
-use crate::fmi::pack::library;
+use crate::pack::bundle::{bundled, image};
+use crate::pack::library;
 
 /// Arguments of `mbfmu install`.
 #[derive(Clone, Debug, Args)]

@@ -1,5 +1,5 @@
 //! `mbfmu pack model.xml -o model.fmu` and/or `--out-dir DIR`: build the model's FMI 2.0
-//! Co-Simulation FMU (see [`crate::fmi::pack`]).
+//! Co-Simulation FMU (see [`crate::pack`]).
 
 use std::io::Write;
 use std::path::PathBuf;
@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use clap::{ArgGroup, Args};
 
 use super::{CliError, SetArgs};
-use crate::fmi::pack::{PackError, pack_with};
+use crate::pack::{PackError, pack_with};
 
 /// Arguments of `mbfmu pack` (at least one of `--out` and `--out-dir`).
 #[derive(Clone, Debug, Args)]

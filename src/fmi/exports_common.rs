@@ -92,7 +92,7 @@ pub unsafe extern "C" fn fmi2Instantiate(
 }
 
 /// Check the arguments and read the model (with its packed start values applied, see
-/// [`super::pack::read_start_values`]) and its linearization states.
+/// [`super::resources::read_start_values`]) and its linearization states.
 ///
 /// # Safety
 /// `guid_p` and `res_p` are NULL or NUL-terminated.
@@ -113,18 +113,7 @@ unsafe fn instantiate(
     // SAFETY: per this function's contract.
     let res = unsafe { text(res_p, "fmuResourceLocation") }.map_err(fail)?;
     let dir = file_uri_to_path(&res).map_err(fail)?;
-    let file = dir.join("model.xml");
-    let model_text =
-        std::fs::read_to_string(&file).map_err(|e| fail(format!("cannot read {}: {e}", file.display())))?;
-    let model = crate::model::parse::load_str(&model_text, &file.display().to_string())
-        .map_err(|e| fail(format!("invalid model: {e}")))?;
-    let (model, own) =
-        super::pack::read_start_values(&dir, model, &model_text).map_err(|e| fail(format!("bad start values: {e}")))?;
-    if given != own {
-        return Err(fail(format!("fmuGUID {given} does not match this FMU's {own} (model {})", file.display())));
-    }
-    let layout = super::pack::read_layout(&dir, &own).map_err(|e| fail(format!("no state layout: {e}")))?;
-    Ok((model, own, layout))
+    super::resources::load(&dir, "fmuGUID", &given).map_err(fail)
 }
 
 /// fmi2FreeInstance (2.1.5): release the instance and the FMU states it still holds

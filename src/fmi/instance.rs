@@ -71,7 +71,7 @@ pub struct Instance {
 impl Instance {
     /// A fresh instance (state Instantiated) of a parsed model whose FMU exposes the
     /// linearization states `layout` (read from its resources, see
-    /// [`super::pack::read_layout`]).
+    /// [`super::resources::read_layout`]).
     pub fn new(base: Model, guid: String, layout: StateLayout, log: Logger) -> Instance {
         let vars = variables(&base, &layout);
         let config = Self::default_config(&base);

@@ -2,7 +2,6 @@
 //! references, enforces the FMI state machine, logs, and calls the engine; it computes
 //! nothing itself.
 
-pub mod bundle;
 pub mod config;
 pub mod exports_common;
 pub mod exports_cs;
@@ -14,8 +13,7 @@ pub mod guid;
 pub mod handle;
 pub mod instance;
 pub mod logger;
-pub mod model_description;
-pub mod pack;
+pub mod resources;
 pub mod state_handles;
 pub mod state_machine;
 pub mod types;

@@ -37,7 +37,7 @@ fn eq34_layout(sys: &System, lay: Layout, sel: &Selection, rows: &IndependentRow
 }
 
 /// The error of a singular Eq. 34: the states no longer parameterize the motion.
-fn singular(p: &OperatingPoint) -> EngineError {
+pub(super) fn singular(p: &OperatingPoint) -> EngineError {
     let names: Vec<String> =
         p.sel.states.iter().map(|s| s.name.clone()).chain(p.sel.velocities.iter().map(|w| w.name())).collect();
     EngineError::Numeric(format!(
@@ -73,6 +73,16 @@ pub fn linearize_with(
     threads: usize,
     route: Route,
 ) -> Result<Linearization, EngineError> {
+    at_point(sim, sel, |p| factored(p, threads, route))
+}
+
+/// Run `f` on the operating point of `sim`'s current state in the states of `sel`, once
+/// they are known to partition the coordinates there.
+pub(super) fn at_point<R>(
+    sim: &mut Simulator,
+    sel: &Selection,
+    f: impl FnOnce(&OperatingPoint) -> Result<R, EngineError>,
+) -> Result<R, EngineError> {
     let (udot, lam) = sim.accelerations()?;
     let (t, ext) = (sim.time(), sim.ext_with(&lam));
     let (q, u) = (sim.q().to_vec(), sim.u().to_vec());
@@ -81,28 +91,33 @@ pub fn linearize_with(
     let lay = Layout::of(sys);
     let eq = eq34_layout(sys, lay, sel, &rows)?;
     check_partition(sys, sel, &q, t, &ext)?;
-    let p = OperatingPoint { sys, sel, eq, lay, rows, q, u, udot, lam, t, ext };
-    let Assembled { k, values } = assemble(&p);
-    let rhs = RightHandSides::of(&p);
-    let sens = Sensitivities::of(&p);
+    f(&OperatingPoint { sys, sel, eq, lay, rows, q, u, udot, lam, t, ext })
+}
+
+/// Eq. 34 at `p`, factored and solved by `route`.
+fn factored(p: &OperatingPoint, threads: usize, route: Route) -> Result<Linearization, EngineError> {
+    let eq = p.eq;
+    let Assembled { k, values } = assemble(p);
+    let rhs = RightHandSides::of(p);
+    let sens = Sensitivities::of(p);
     let mut lu = SparseLu::new();
-    lu.factor(eq.dim(), &k).map_err(|_| singular(&p))?;
+    lu.factor(eq.dim(), &k).map_err(|_| singular(p))?;
     let ncols = eq.ns() + p.ni();
-    let jobs = row_jobs(&p, &sens);
+    let jobs = row_jobs(p, &sens);
     let by_rows = match route {
         Route::Auto => jobs.len() < ncols,
         Route::Columns => false,
         Route::Rows => true,
     };
     let sol = if by_rows {
-        solve_by_rows(&p, &lu, &rhs, &sens, &jobs, threads)
+        solve_by_rows(p, &lu, &rhs, &sens, &jobs, threads)
     } else {
         let fill = |col: usize, b: &mut [f64]| rhs.fill(rhs.column(col), b);
         let take = |col: usize, x: &[f64]| sens.keep(rhs.column(col), x);
         lu.solve_columns(ncols, threads, false, fill, take)
     };
     let solves = if by_rows { jobs.len() } else { ncols };
-    extract(&p, &sens, &sol.ok_or_else(|| singular(&p))?, values, solves)
+    extract(p, &sens, &sol.ok_or_else(|| singular(p))?, values, solves)
 }
 
 /// A row of [A B; C D] to solve for by the transposed system: kept row `r`

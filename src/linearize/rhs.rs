@@ -94,13 +94,19 @@ impl RightHandSides {
 
     /// Write right-hand side `col` into the zeroed `b`.
     pub fn fill(&self, col: Column, b: &mut [f64]) {
+        self.add(col, 1.0, b);
+    }
+
+    /// Add `w` times right-hand side `col` to `b` (a combination of columns: one solve
+    /// gives the same combination of their solutions).
+    pub fn add(&self, col: Column, w: f64, b: &mut [f64]) {
         match col {
-            Column::S(i) => b[self.eq.row_at(Equation::Eq34k, i)] = 1.0,
-            Column::W(i) => b[self.eq.row_at(Equation::Eq34j, i)] = 1.0,
-            Column::X(i) => b[self.eq.row_at(Equation::XBar, i)] = 1.0,
+            Column::S(i) => b[self.eq.row_at(Equation::Eq34k, i)] += w,
+            Column::W(i) => b[self.eq.row_at(Equation::Eq34j, i)] += w,
+            Column::X(i) => b[self.eq.row_at(Equation::XBar, i)] += w,
             Column::Input(v) => {
                 for &(r, val) in &self.by_input[v] {
-                    b[r] += val;
+                    b[r] += w * val;
                 }
             }
         }

@@ -46,13 +46,19 @@ impl Sensitivities {
     /// Kept of solution `x` of right-hand side `col`: Ṡ, Ẇ, Ẋ, then each output's
     /// sensitivity.
     pub fn keep(&self, col: Column, x: &[f64]) -> Vec<f64> {
+        self.keep_as(col.kinematic(), x)
+    }
+
+    /// [`Sensitivities::keep`] for a solution of state columns (`kinematic`) or input
+    /// columns, or of a combination of columns of one kind.
+    pub fn keep_as(&self, kinematic: bool, x: &[f64]) -> Vec<f64> {
         let eq = &self.eq;
         let mut keep = Vec::with_capacity(eq.ns() + self.grads.len());
         keep.extend_from_slice(&x[eq.col(Unknown::SDot)..][..eq.s0]);
         keep.extend_from_slice(&x[eq.col(Unknown::WDot)..][..eq.s1]);
         let xdot = eq.col(Unknown::Z) + eq.nx; // Z = (X, Ẋ, V, a)
         keep.extend_from_slice(&x[xdot..xdot + eq.nx]);
-        keep.extend(self.grads.iter().map(|g| self.sensitivity(g, x, col.kinematic())));
+        keep.extend(self.grads.iter().map(|g| self.sensitivity(g, x, kinematic)));
         keep
     }
 
@@ -114,18 +120,24 @@ impl Sensitivities {
     /// row for every column at once. Only for a row whose weights are finite
     /// ([`Sensitivities::row_finite`]).
     pub fn functional(&self, r: usize, kinematic: bool, g: &mut [f64]) {
+        self.add_functional(r, kinematic, 1.0, g);
+    }
+
+    /// Add `w` times kept row `r`'s functional ([`Sensitivities::functional`]) to `g`: a
+    /// combination of rows, which one transposed solve yields for every column at once.
+    pub fn add_functional(&self, r: usize, kinematic: bool, w: f64, g: &mut [f64]) {
         let eq = &self.eq;
         let (s0, s1, nx) = (eq.s0, eq.s1, eq.nx);
         if r < s0 {
-            g[eq.at(Unknown::SDot, r)] = 1.0;
+            g[eq.at(Unknown::SDot, r)] += w;
         } else if r < s0 + s1 {
-            g[eq.at(Unknown::WDot, r - s0)] = 1.0;
+            g[eq.at(Unknown::WDot, r - s0)] += w;
         } else if r < s0 + s1 + nx {
-            g[eq.col(Unknown::Z) + nx + (r - s0 - s1)] = 1.0; // Z = (X, Ẋ, V, a)
+            g[eq.col(Unknown::Z) + nx + (r - s0 - s1)] += w; // Z = (X, Ẋ, V, a)
         } else {
-            self.coefficients(&self.grads[r - s0 - s1 - nx], kinematic, &mut |at, w| {
+            self.coefficients(&self.grads[r - s0 - s1 - nx], kinematic, &mut |at, c| {
                 if let Some(i) = at {
-                    g[i] += w;
+                    g[i] += w * c;
                 }
             });
         }

@@ -1,6 +1,6 @@
 //! The structure ARCHITECTURE.md promises, checked on the text of `src/`: every reference
 //! from one file of the library to another (`crate::a::b`, `super::x`, `use` trees) points
-//! down the layers (ad, geom → modal → model → mechanics → dae → linearize → fmi, cli), the files
+//! down the layers (ad, geom → modal → model → mechanics → dae → linearize → fmi → pack → cli), the files
 //! form no cycle, and the FMI shell reaches the engine only through the faces that
 //! ARCHITECTURE.md names. Re-exports (`pub use`) and module declarations are not
 //! references; `#[cfg(test)]` modules are left out.
@@ -9,7 +9,9 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 /// The layers, lowest first: a file may refer to its own layer and those below.
-const LAYERS: [&str; 9] = ["ad", "geom", "modal", "model", "mechanics", "dae", "linearize", "fmi", "cli"];
+/// `pack` (the build-time packer) sits above `fmi` (what runs inside a host): the packer
+/// writes what the shell reads, never the other way.
+const LAYERS: [&str; 10] = ["ad", "geom", "modal", "model", "mechanics", "dae", "linearize", "fmi", "pack", "cli"];
 
 /// What the FMI shell may use of the layers below it: the model, and the faces of the
 /// engine (what `dae` and `linearize` export from their mod.rs; the byte codec of saved

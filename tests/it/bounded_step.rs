@@ -10,12 +10,12 @@ use mbfmu::dae::{DEFAULT_MAX_STEPS, SimOptions, Simulator};
 use mbfmu::fmi::exports_common::*;
 use mbfmu::fmi::exports_cs::*;
 use mbfmu::fmi::exports_state::*;
-use mbfmu::fmi::model_description::write;
 use mbfmu::fmi::state_machine::State;
 use mbfmu::fmi::types::{CO_SIMULATION, Component, LAST_SUCCESSFUL_TIME, Status};
 use mbfmu::fmi::variables::{MAX_STEPS_NAME, variables};
 use mbfmu::linearize::StateLayout;
 use mbfmu::model::parse::load_str;
+use mbfmu::pack::fmi2_description::write;
 use std::ffi::CString;
 
 /// Step attempts the four-bar's discarded step may make before the step size collapses

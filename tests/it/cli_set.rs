@@ -303,7 +303,7 @@ fn pack_set_on_a_state_is_the_fmus_start_and_a_host_value_replaces_it() {
     assert_eq!(std::fs::read_to_string(dir.join("resources/start_values.txt")).unwrap(), "hinge.angle=0.3\n");
     let vars = mbfmu::fmi::variables::variables(
         &mbfmu::model::parse::load_str(&model_text("pendulum.xml"), "p.xml").unwrap(),
-        &mbfmu::fmi::pack::read_layout(&dir.join("resources"), &guid_of(&xml)).unwrap(),
+        &mbfmu::fmi::resources::read_layout(&dir.join("resources"), &guid_of(&xml)).unwrap(),
     );
     let vr = |n: &str| vars.iter().find(|v| v.name == n).unwrap().value_reference;
     for host_value in [None, Some(-2.0)] {

@@ -7,9 +7,9 @@ use crate::common::host::{CALLBACKS, resources};
 use crate::common::model_dir;
 use mbfmu::fmi::exports_common::*;
 use mbfmu::fmi::exports_cs::*;
-use mbfmu::fmi::model_description::write;
 use mbfmu::fmi::types::{CO_SIMULATION, Component, Status};
 use mbfmu::model::parse::load_str;
+use mbfmu::pack::fmi2_description::write;
 use std::collections::BTreeMap;
 use std::ffi::CString;
 

@@ -4,7 +4,7 @@
 
 use crate::common::{guid, guid_of};
 use mbfmu::fmi::exports_common::*;
-use mbfmu::fmi::pack::{LAYOUT_FILE, read_layout};
+use mbfmu::fmi::resources::{LAYOUT_FILE, read_layout};
 use mbfmu::fmi::types::CO_SIMULATION;
 use mbfmu::fmi::variables::{Target, variables};
 use mbfmu::linearize::{StateLayout, selection_at_start, selection_by_name};
@@ -189,7 +189,7 @@ fn a_missing_unreadable_or_foreign_layout_fails_instantiation_without_a_panic() 
     assert!(instantiate_at(&res, &pendulum), "as packed");
     let file = res.join(LAYOUT_FILE);
     let good = std::fs::read_to_string(&file).expect("written by the host helper");
-    let foreign = mbfmu::fmi::pack::layout_file(&other, "other.xml").expect("a model").0;
+    let foreign = mbfmu::pack::layout_file(&other, "other.xml").expect("a model").0;
     let refusals: [(&[u8], &str); 3] =
         [(b"garbage\n", "not a state layout"), (b"mbfmu state layout 1\nS\tx\n", "line 2"), (&foreign, "belongs to")];
     for (bytes, why) in refusals {
@@ -212,7 +212,7 @@ fn the_layout_file_reads_back_to_the_selection_at_start_for_every_model() {
         // Under its own path: a flexible body's modal data file is found beside it.
         let (model_text, label) = (std::fs::read_to_string(&path).expect("readable"), path.display().to_string());
         let model = load_str(&model_text, &label).unwrap_or_else(|e| panic!("{e}"));
-        let (bytes, warning) = mbfmu::fmi::pack::layout_file(&model_text, &label).expect("a model");
+        let (bytes, warning) = mbfmu::pack::layout_file(&model_text, &label).expect("a model");
         assert_eq!(warning, None, "{}", path.display());
         let read = StateLayout::from_text(&text(&bytes), &guid_of(&path)).unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(read, StateLayout::at_start(&model), "{}", path.display());

@@ -36,6 +36,7 @@ mod linearize;
 mod linearize_loads;
 mod linearize_routes;
 mod linearize_seed;
+mod linearize_seeded;
 mod malformed;
 mod memory_valgrind;
 mod modal;

@@ -8,8 +8,8 @@
 use std::path::Path;
 
 use crate::common::{model_files, root};
-use mbfmu::fmi::model_description::write;
 use mbfmu::model::load_file;
+use mbfmu::pack::fmi2_description::write;
 
 /// Replace the value of attribute `name` (every occurrence) by `*`.
 fn blank_attr(xml: &str, name: &str) -> String {

@@ -35,7 +35,7 @@ fn temp_dir(name: &str) -> PathBuf {
 /// The cdylib the packer embeds: this test executable runs from `target/<profile>/deps/`
 /// and the binary from `target/<profile>/`, and both search the same three places.
 fn library() -> PathBuf {
-    mbfmu::fmi::pack::find_library().unwrap_or_else(|e| panic!("{e}"))
+    mbfmu::pack::find_library().unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// Entries of a zip archive, name -> bytes, in archive order.
@@ -197,9 +197,9 @@ fn installed_mbfmu_packs_from_any_directory_with_no_environment() {
             .output()
             .unwrap();
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        std::fs::read(empty.join("p/binaries").join(mbfmu::fmi::pack::PLATFORM).join("pendulum.so")).unwrap()
+        std::fs::read(empty.join("p/binaries").join(mbfmu::pack::PLATFORM).join("pendulum.so")).unwrap()
     };
-    let lib = mbfmu::fmi::pack::library().unwrap();
+    let lib = mbfmu::pack::library().unwrap();
     assert_eq!(pack(&installed), lib);
     // Installing from the installed copy embeds the library once, not twice.
     let again = root.join("again");

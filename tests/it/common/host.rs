@@ -243,7 +243,7 @@ pub fn resources_of(path: &std::path::Path, tag: &str) -> (PathBuf, CString) {
 pub fn resources(text: &str, tag: &str) -> (PathBuf, CString) {
     // The layout carries the GUID, which names this build of the engine: hashing it with the
     // text keeps a directory left by another build under a reused process id from being read.
-    let layout = mbfmu::fmi::pack::layout_file(text, "model.xml").ok().map(|(l, _)| l);
+    let layout = mbfmu::pack::layout_file(text, "model.xml").ok().map(|(l, _)| l);
     let id = {
         use std::hash::{Hash, Hasher};
         let mut h = std::collections::hash_map::DefaultHasher::new();
@@ -261,7 +261,7 @@ pub fn resources(text: &str, tag: &str) -> (PathBuf, CString) {
         // The layout first: model.xml present means both are.
         if let Some(layout) = layout {
             std::fs::write(&tmp, layout).unwrap_or_else(|e| panic!("{}: {e}", tmp.display()));
-            let to = dir.join(mbfmu::fmi::pack::LAYOUT_FILE);
+            let to = dir.join(mbfmu::fmi::resources::LAYOUT_FILE);
             std::fs::rename(&tmp, &to).unwrap_or_else(|e| panic!("{}: {e}", to.display()));
         }
         std::fs::write(&tmp, text).unwrap_or_else(|e| panic!("{}: {e}", tmp.display()));

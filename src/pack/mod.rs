@@ -1,4 +1,4 @@
-//! Pack a model file into an FMI 2.0 Co-Simulation FMU:
+//! The build-time packer (`mbfmu pack`): a model file into an FMI Co-Simulation FMU:
 //!
 //! ```text
 //! modelDescription.xml
@@ -13,17 +13,20 @@
 //! the state selection and the values of an instance not told otherwise all come from the
 //! model with them applied, while `resources/model.xml` stays the user's file byte for
 //! byte; an instance applies `resources/start_values.txt` at fmi2Instantiate
-//! ([`read_start_values`]), and the GUID covers it ([`guid_with`]).
+//! ([`crate::fmi::resources::read_start_values`]), and the GUID covers it ([`guid_with`]).
 //!
 //! The linearization states are selected once, here (an engine run,
-//! [`crate::linearize::for_fmu`]); an instance reads them back with [`read_layout`]
+//! [`crate::linearize::for_fmu`]); an instance reads them back with [`crate::fmi::resources::read_layout`]
 //! instead of selecting them again. When they cannot be selected the FMU is still packed,
 //! without states, and [`Packed::warnings`] says why (the engine's error then shows again,
 //! located, at fmi2EnterInitializationMode).
 //!
 //! The cdylib is found through the environment variable `MBFMU_LIB` (a file path), else
-//! inside the running executable (an installed `mbfmu`, see [`super::bundle`]), else next
+//! inside the running executable (an installed `mbfmu`, see [`bundle`]), else next
 //! to it (a cargo build, see [`find_library`]).
+
+pub mod bundle;
+pub mod fmi2_description;
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -31,18 +34,12 @@ use std::path::{Path, PathBuf};
 use zip::CompressionMethod;
 use zip::write::SimpleFileOptions;
 
-use super::guid::{guid, guid_with, model_identifier};
-use super::model_description;
 use crate::dae::StartValues;
+use crate::fmi::guid::{guid, guid_with, model_identifier};
+use crate::fmi::resources::{LAYOUT_FILE, START_VALUES_FILE};
 use crate::linearize::{FmuLinearization, StateLayout, for_fmu};
-use crate::model::overrides::{parse_start_values, start_values_text};
-use crate::model::{Model, ModelError, load_str};
-
-/// The state layout's file in the FMU's resources directory.
-pub const LAYOUT_FILE: &str = "states.txt";
-
-/// The start values' file in the FMU's resources directory (only when packed with some).
-pub const START_VALUES_FILE: &str = "start_values.txt";
+use crate::model::overrides::start_values_text;
+use crate::model::{ModelError, load_str};
 
 /// FMI platform folder under `binaries/`.
 #[cfg(target_os = "macos")]
@@ -145,11 +142,11 @@ pub fn find_library() -> Result<PathBuf, PackError> {
 }
 
 /// The FMU library's bytes: `MBFMU_LIB` if set, else the copy embedded in the running
-/// executable by `mbfmu install` ([`super::bundle`]), else the cdylib of the build the
+/// executable by `mbfmu install` ([`bundle`]), else the cdylib of the build the
 /// executable comes from ([`find_library`]).
 pub fn library() -> Result<Vec<u8>, PackError> {
     if std::env::var_os("MBFMU_LIB").is_none()
-        && let Some(lib) = super::bundle::embedded_library()
+        && let Some(lib) = bundle::embedded_library()
     {
         return Ok(lib);
     }
@@ -183,7 +180,7 @@ fn contents(model_path: &Path, set: &[(String, f64)]) -> Result<Contents, PackEr
     let lib = library()?;
     let FmuLinearization { layout, structure, starts } = for_fmu(&model);
     let guid = guid_with(&base, text, &start_values);
-    let xml = model_description::describe(&model, &guid, &layout, &structure, &starts);
+    let xml = fmi2_description::describe(&model, &guid, &layout, &structure, &starts);
     let warnings = layout
         .missing
         .iter()
@@ -243,42 +240,11 @@ fn modal_files(model: &crate::model::Model) -> Result<Vec<(String, Vec<u8>)>, Pa
 /// build a resources directory themselves (tests); the engine runs on a stack of its own
 /// when the caller's is small (as in the exports).
 pub fn layout_file(model_text: &str, label: &str) -> Result<(Vec<u8>, Option<String>), ModelError> {
-    super::guard::with_stack(|| {
+    crate::fmi::guard::with_stack(|| {
         let model = load_str(model_text, label)?;
         let layout = StateLayout::at_start(&model);
         Ok((layout.to_text(&guid(&model, model_text)).into_bytes(), layout.missing))
     })
-}
-
-/// The state layout of the FMU whose resources directory is `resources` and whose model
-/// has the GUID `guid` (read at fmi2Instantiate; no engine run).
-pub fn read_layout(resources: &Path, guid: &str) -> Result<StateLayout, String> {
-    let file = resources.join(LAYOUT_FILE);
-    let text = std::fs::read_to_string(&file).map_err(|e| format!("cannot read {}: {e}", file.display()))?;
-    StateLayout::from_text(&text, guid).map_err(|e| format!("{}: {e}", file.display()))
-}
-
-/// The model of the FMU whose resources directory is `resources`, read from `model_text`
-/// (`base`), with its start values applied, and its GUID (read at fmi2Instantiate). No
-/// `start_values.txt`: `base` and its plain GUID. A malformed file, an unknown name or a
-/// value the model rejects is an error naming the file.
-pub fn read_start_values(resources: &Path, base: Model, model_text: &str) -> Result<(Model, String), String> {
-    let file = resources.join(START_VALUES_FILE);
-    let text = match std::fs::read_to_string(&file) {
-        Ok(t) => t,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-            let own = guid(&base, model_text);
-            return Ok((base, own));
-        }
-        Err(e) => return Err(format!("cannot read {}: {e}", file.display())),
-    };
-    let bad = |e: String| format!("{}: {e}", file.display());
-    let pairs = parse_start_values(&text).map_err(bad)?;
-    let overrides = base.resolve_overrides(&pairs).map_err(bad)?;
-    let own = guid_with(&base, model_text, &start_values_text(&overrides));
-    let model = base.with_overrides(&overrides).map_err(bad)?;
-    StartValues::check_names(&model).map_err(bad)?;
-    Ok((model, own))
 }
 
 /// Write the FMU of the model file `model_path` as the zip archive `out` (replacing it).

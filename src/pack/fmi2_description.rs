@@ -1,6 +1,6 @@
 //! `modelDescription.xml` of a model's FMI 2.0 Co-Simulation FMU.
 //!
-//! The variables and their value references come from [`super::variables`] (shared with
+//! The variables and their value references come from [`crate::fmi::variables`] (shared with
 //! the C API). `<ModelStructure>` writes the dependencies of
 //! [`crate::linearize::structure`], mapping its indices (states as columns of A, inputs,
 //! parameters) to FMI variable indices.
@@ -9,8 +9,8 @@ use crate::model::units::{self, BASE_NAMES};
 use std::collections::BTreeSet;
 use std::fmt::Write as _;
 
-use super::guid::{ENGINE_VERSION, guid, model_identifier};
-use super::variables::{Causality, Target, Variable, variables};
+use crate::fmi::guid::{ENGINE_VERSION, guid, model_identifier};
+use crate::fmi::variables::{Causality, Target, Variable, variables};
 use crate::linearize::{Dependencies, FmuLinearization, ModelStructure, StateLayout, StateValues, for_fmu};
 use crate::model::Model;
 
@@ -23,7 +23,7 @@ pub fn write(model: &Model, model_text: &str) -> String {
 }
 
 /// The modelDescription.xml of the FMU of `model` with the GUID `guid` (see
-/// [`super::guid`]; `model` is the model as the FMU starts, start values applied), the
+/// [`crate::fmi::guid`]; `model` is the model as the FMU starts, start values applied), the
 /// linearization states `layout` and the dependencies `structure` (of the same selection,
 /// see [`for_fmu`]).
 pub fn describe(
