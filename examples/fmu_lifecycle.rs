@@ -259,7 +259,8 @@ impl Plan {
         let text =
             std::fs::read_to_string(model_path).unwrap_or_else(|e| panic!("{}: {e}", Path::new(model_path).display()));
         let model = mbfmu::model::parse::load_str(&text, model_path).unwrap_or_else(|e| panic!("{e}"));
-        let vars = variables(&model, &mbfmu::linearize::StateLayout::at_start(&model));
+        let vars =
+            variables(&model, &mbfmu::linearize::StateLayout::at_start(&model), mbfmu::fmi::variables::Standard::Fmi2);
         let pick = |f: &dyn Fn(&Variable) -> bool| vars.iter().filter(|v| f(v)).map(|v| v.value_reference).collect();
         Plan {
             steps,

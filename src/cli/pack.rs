@@ -1,5 +1,5 @@
-//! `mbfmu pack model.xml -o model.fmu` and/or `--out-dir DIR`: build the model's FMI 2.0
-//! Co-Simulation FMU (see [`crate::pack`]).
+//! `mbfmu pack model.xml -o model.fmu` and/or `--out-dir DIR` [`--fmi 3`]: build the model's
+//! FMI 2.0 (or 3.0) Co-Simulation FMU (see [`crate::pack`]).
 
 use std::io::Write;
 use std::path::PathBuf;
@@ -7,6 +7,7 @@ use std::path::PathBuf;
 use clap::{ArgGroup, Args};
 
 use super::{CliError, SetArgs};
+use crate::fmi::variables::Standard;
 use crate::pack::{PackError, pack_with};
 
 /// Arguments of `mbfmu pack` (at least one of `--out` and `--out-dir`).
@@ -21,6 +22,9 @@ pub struct PackArgs {
     /// Write the FMU's files, unzipped, into this directory.
     #[arg(long, value_name = "DIR")]
     pub out_dir: Option<PathBuf>,
+    /// FMI version of the FMU: 2 (FMI 2.0, the default) or 3 (FMI 3.0).
+    #[arg(long, value_name = "VERSION", default_value = "2", value_parser = ["2", "3"])]
+    pub fmi: String,
     /// Start values instead of the file's: the FMU's default (and modelDescription
     /// `start`) of each parameter set.
     #[command(flatten)]
@@ -43,7 +47,8 @@ impl From<PackError> for CliError {
 /// Pack the FMU and print one line: modelIdentifier, GUID and where it was written (and
 /// what the FMU lacks, as warnings on stderr).
 pub fn run(args: &PackArgs, out: &mut dyn Write) -> Result<(), CliError> {
-    let packed = pack_with(&args.model, &args.set.pairs()?, args.out.as_deref(), args.out_dir.as_deref())?;
+    let standard = if args.fmi == "3" { Standard::Fmi3 } else { Standard::Fmi2 };
+    let packed = pack_with(&args.model, &args.set.pairs()?, standard, args.out.as_deref(), args.out_dir.as_deref())?;
     packed.warnings.iter().for_each(|w| eprintln!("warning: {w}"));
     let dest: Vec<String> = args.out.iter().chain(&args.out_dir).map(|p| p.display().to_string()).collect();
     writeln!(out, "packed FMU '{}' guid {} -> {}", packed.model_identifier, packed.guid, dest.join(", "))

@@ -17,6 +17,7 @@ use super::types::{
     ValueReference,
 };
 use super::uri::file_uri_to_path;
+use super::variables::Standard;
 use libc::{c_char, c_int, size_t};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
@@ -78,7 +79,7 @@ pub unsafe extern "C" fn fmi2Instantiate(
             // SAFETY: NUL-terminated strings or NULL per FMI.
             let (model, guid, layout) =
                 name.and_then(|name| unsafe { instantiate(&name, fmuType, fmuGUID, fmuResourceLocation) })?;
-            Ok::<_, String>(Instance::new(model, guid, layout, Logger::new(loggingOn == TRUE)))
+            Ok::<_, String>(Instance::new(model, guid, layout, Logger::new(loggingOn == TRUE), Standard::Fmi2))
         });
         match made {
             Ok(inst) => create(inst, sink),

@@ -46,26 +46,41 @@ pub fn panic_text(payload: &(dyn std::any::Any + Send)) -> String {
 /// one busy with another call (the host's logger calling back, a second thread) gives
 /// fmi2Error and a message. The messages reach the host's logger after `body` is done.
 pub fn guarded(c: Component, func: Func, body: impl FnOnce(&mut Instance) -> Result<Status, String>) -> Status {
+    guarded_as(c, func, None, body)
+}
+
+/// [`guarded`] for a function whose C name is `name` rather than the table's (the FMI 3
+/// functions of what the FMU lacks share one row, [`Func::Unsupported`]).
+pub fn guarded_as(
+    c: Component,
+    func: Func,
+    name: Option<&'static str>,
+    body: impl FnOnce(&mut Instance) -> Result<Status, String>,
+) -> Status {
     let mut session = match enter(c) {
         Ok(s) => s,
         Err(refused) => {
-            refused.report(func.name());
+            refused.report_for(func, name);
             return Status::Error;
         }
     };
     let inst = session.instance();
+    let standard = inst.standard;
+    let fname = name.unwrap_or_else(|| func.name_in(standard));
     let run = catch_unwind(AssertUnwindSafe(|| {
-        if let Err(msg) = check(inst.state, func) {
+        if func == Func::Unsupported {
+            // No state forbids the call; the body says why it cannot be done.
+        } else if let Err(msg) = check(inst.state, func, standard) {
             inst.log(Status::Error, &msg);
             return Status::Error;
         }
         let before = inst.state;
         let status = with_stack(|| body(inst)).unwrap_or_else(|msg| {
-            inst.log(Status::Error, &format!("{}: {msg}", func.name()));
+            inst.log(Status::Error, &format!("{fname}: {msg}"));
             Status::Error
         });
         if inst.state != before {
-            inst.log(Status::Ok, &format!("{}: state {before:?} -> {:?}", func.name(), inst.state));
+            inst.log(Status::Ok, &format!("{fname}: state {before:?} -> {:?}", inst.state));
         }
         status
     }));
@@ -76,7 +91,7 @@ pub fn guarded(c: Component, func: Func, body: impl FnOnce(&mut Instance) -> Res
         let _ = catch_unwind(AssertUnwindSafe(|| {
             let inst = session.instance();
             inst.state = state;
-            inst.log(status, &format!("{}: internal error (panic): {what}", func.name()));
+            inst.log(status, &format!("{fname}: internal error (panic): {what}"));
         }));
         status
     });

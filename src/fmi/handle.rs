@@ -7,6 +7,7 @@
 
 use super::instance::Instance;
 use super::logger::Sink;
+use super::state_machine::Func;
 use super::types::{Component, Status};
 use std::cell::{Cell, UnsafeCell};
 use std::collections::BTreeSet;
@@ -44,6 +45,14 @@ pub enum Refused {
 }
 
 impl Refused {
+    /// Tell the host why `func` (of the instance's FMI version; `name` if given) was
+    /// refused.
+    pub fn report_for(&self, func: Func, name: Option<&str>) {
+        if let Refused::Busy(sink) = self {
+            self.report(name.unwrap_or_else(|| func.name_in(sink.standard())));
+        }
+    }
+
     /// Tell the host (when there is a logger to tell) why `func` was refused.
     pub fn report(&self, func: &str) {
         let Refused::Busy(sink) = self else { return };

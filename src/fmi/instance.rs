@@ -8,11 +8,12 @@ use super::logger::Logger;
 use super::state_handles::StateHandles;
 use super::state_machine::State;
 use super::types::Status;
-use super::variables::{Target, Variable, variables};
+use super::variables::{Standard, Target, Variable, variables};
 use crate::dae::StartValues;
 use crate::dae::{DEFAULT_MAX_STEPS, SimOptions, SimState, Simulator};
 use crate::linearize::{
-    Linearization, Selection, StateLayout, StateTarget, linearize, selection_by_name, start_values, state_values,
+    Linearization, Seeded, Selection, StateLayout, StateTarget, linearize, selection_by_name, start_values,
+    state_values,
 };
 use crate::model::Model;
 
@@ -29,6 +30,9 @@ pub struct Built {
     pub sel: Result<Selection, String>,
     /// The last linearization and the engine state it belongs to (cache).
     pub lin: Option<(SimState, Linearization)>,
+    /// Eq. 34 factored at the last point FMI 3 derivatives were asked at, and that
+    /// point's engine state (cache).
+    pub seeded: Option<(SimState, Seeded)>,
 }
 
 /// Outcome of fmi2DoStep once its arguments are valid.
@@ -47,6 +51,10 @@ pub struct Instance {
     pub state: State,
     /// GUID of the model text: identifies whose FMU states this instance accepts.
     pub guid: String,
+    /// The FMI version the host called fmiXInstantiate… of.
+    pub standard: Standard,
+    /// FMI 3: the host uses Event Mode (`eventModeUsed`): initialization ends in it.
+    pub event_mode: bool,
     base: Model,
     /// The linearization states the FMU was packed with.
     layout: StateLayout,
@@ -72,14 +80,16 @@ impl Instance {
     /// A fresh instance (state Instantiated) of a parsed model whose FMU exposes the
     /// linearization states `layout` (read from its resources, see
     /// [`super::resources::read_layout`]).
-    pub fn new(base: Model, guid: String, layout: StateLayout, log: Logger) -> Instance {
-        let vars = variables(&base, &layout);
+    pub fn new(base: Model, guid: String, layout: StateLayout, log: Logger, standard: Standard) -> Instance {
+        let vars = variables(&base, &layout, standard);
         let config = Self::default_config(&base);
         let last_time = config.start;
         Instance {
             log,
             state: State::Instantiated,
             guid,
+            standard,
+            event_mode: false,
             base,
             layout,
             vars,
@@ -180,7 +190,7 @@ impl Instance {
             }
         }
         let sel = selection_by_name(sim.system(), &self.layout);
-        Ok(Built { sim, params: cfg.params.clone(), tol: cfg.tol, sel, lin: None })
+        Ok(Built { sim, params: cfg.params.clone(), tol: cfg.tol, sel, lin: None, seeded: None })
     }
 
     /// The start values set on states, as conditions on the system of `model`.
@@ -314,6 +324,7 @@ impl Instance {
                         _ => z[2 * nx + k],
                     }
                 }
+                Target::Time => self.built.as_ref().filter(|_| !self.dirty).map_or(self.config.start, |b| b.sim.time()),
                 Target::MaxSteps => unreachable!("refused above: an Integer variable"),
             };
         }
@@ -364,7 +375,7 @@ impl Instance {
                     self.state_target(var).map_err(|e| format!("{e} (vr {vr}) and cannot be set"))?;
                     targets.push((var.target, v));
                 }
-                Target::VelocityDerivative(_) | Target::DiffDerivative(_) | Target::UserVariable(_) => {
+                Target::VelocityDerivative(_) | Target::DiffDerivative(_) | Target::UserVariable(_) | Target::Time => {
                     return Err(format!("'{}' (vr {vr}) is computed by the engine and cannot be set", var.name));
                 }
                 Target::Parameter(_) if self.initialized() => {
@@ -479,6 +490,88 @@ impl Instance {
             *o = acc;
         }
         self.all_finite("the directional derivative", unknowns, out)
+    }
+
+    /// The columns (states S, W, X, then inputs) of the knowns `knowns` and the rows
+    /// (state derivatives, then outputs) of the unknowns `unknowns` of [A B; C D].
+    fn positions(&self, unknowns: &[u32], knowns: &[u32]) -> Result<(Vec<usize>, Vec<usize>), String> {
+        let ns = self.vars.iter().filter(|v| v.known.is_some()).count();
+        let mut cols = Vec::with_capacity(knowns.len());
+        for &vr in knowns {
+            let v = self.var(vr)?;
+            let c = match v.target {
+                Target::Input(i) => Some(ns + i),
+                _ => v.known,
+            };
+            cols.push(c.ok_or_else(|| format!("known '{}' (vr {vr}) is neither a state nor an input", v.name))?);
+        }
+        let mut rows = Vec::with_capacity(unknowns.len());
+        for &vr in unknowns {
+            let v = self.var(vr)?;
+            let r = match v.target {
+                Target::Output(o) => Some(ns + o),
+                _ => v.unknown,
+            };
+            rows.push(r.ok_or_else(|| {
+                format!("unknown '{}' (vr {vr}) is neither a state derivative nor an output", v.name)
+            })?);
+        }
+        Ok((rows, cols))
+    }
+
+    /// Eq. 34 factored at the current point, once per engine state (cached until the
+    /// state, an input or a parameter changes).
+    fn seeded(&mut self) -> Result<&mut Seeded, String> {
+        self.simulator()?;
+        let b = self.built.as_mut().expect("built");
+        let key = b.sim.snapshot();
+        if b.seeded.as_ref().is_none_or(|(k, _)| *k != key) {
+            let sel = b.sel.as_ref().map_err(|e| format!("no linearization states: {e}"))?;
+            let s = Seeded::at(&mut b.sim, sel).map_err(|e| e.to_string())?;
+            b.seeded = Some((key, s));
+        }
+        Ok(&mut b.seeded.as_mut().expect("cached").1)
+    }
+
+    /// FMI 3 derivatives at the current point, each one solve of Eq. 34 per column kind
+    /// ([`Seeded`]): `adjoint` false: sensitivity = J·seed (fmi3GetDirectionalDerivative,
+    /// a seed per known, a sensitivity per unknown); true: sensitivityᵀ = seedᵀ·J
+    /// (fmi3GetAdjointDerivative, a seed per unknown, a sensitivity per known); J the
+    /// rows `unknowns` and columns `knowns` of [A B; C D].
+    pub fn seeded_derivative(
+        &mut self,
+        unknowns: &[u32],
+        knowns: &[u32],
+        seed: &[f64],
+        out: &mut [f64],
+        adjoint: bool,
+    ) -> Result<(), String> {
+        let (rows, cols) = self.positions(unknowns, knowns)?;
+        let (seed_at, out_at) = if adjoint { (&rows, &cols) } else { (&cols, &rows) };
+        if seed.len() != seed_at.len() || out.len() != out_at.len() {
+            return Err(format!(
+                "nSeed = {} and nSensitivity = {} must be {} and {} (the numbers of {})",
+                seed.len(),
+                out.len(),
+                seed_at.len(),
+                out_at.len(),
+                if adjoint { "unknowns and knowns" } else { "knowns and unknowns" }
+            ));
+        }
+        if let Some(v) = seed.iter().find(|v| !v.is_finite()) {
+            return Err(format!("seed value {v} is not finite"));
+        }
+        let s = self.seeded()?;
+        let mut full = vec![0.0; if adjoint { s.unknowns() } else { s.knowns() }];
+        for (&p, &v) in seed_at.iter().zip(seed) {
+            full[p] += v;
+        }
+        let product = if adjoint { s.adjoint(&full) } else { s.directional(&full) }.map_err(|e| e.to_string())?;
+        for (o, &p) in out.iter_mut().zip(out_at.iter()) {
+            *o = product[p];
+        }
+        let named = if adjoint { knowns } else { unknowns };
+        self.all_finite("the derivative", named, out)
     }
 
     /// fmi2SetRealInputDerivatives (order 1 only: inputs change linearly over a step).

@@ -5,17 +5,18 @@
 //! The text is always passed as the argument of a `"%s"` format, so a `%` in a message
 //! (a path, a user name) is never read as a conversion.
 
-use super::types::{CallbackFunctions, ComponentEnvironment, LoggerFn, Status};
+use super::types::{CallbackFunctions, ComponentEnvironment, LogMessageFn, LoggerFn, Status};
+use super::variables::Standard;
 use std::collections::VecDeque;
 use std::ffi::{CStr, CString};
 
 /// The log categories (modelDescription.xml `LogCategories`) and what each carries.
 pub const CATEGORIES: [(&CStr, &str); 6] = [
     (c"logEvents", "Calls and state changes"),
-    (c"logStatusWarning", "Messages of calls returning fmi2Warning"),
-    (c"logStatusDiscard", "Messages of calls returning fmi2Discard"),
-    (c"logStatusError", "Messages of calls returning fmi2Error"),
-    (c"logStatusFatal", "Messages of calls returning fmi2Fatal"),
+    (c"logStatusWarning", "Messages of calls returning Warning"),
+    (c"logStatusDiscard", "Messages of calls returning Discard"),
+    (c"logStatusError", "Messages of calls returning Error"),
+    (c"logStatusFatal", "Messages of calls returning Fatal"),
     (c"logAll", "Every message"),
 ];
 
@@ -99,28 +100,51 @@ impl Logger {
     }
 }
 
+/// The host's logger callback of either FMI version.
+#[derive(Clone, Copy)]
+enum Callback {
+    /// fmi2CallbackLogger (with the instance name and a printf format).
+    Fmi2(LoggerFn),
+    /// fmi3LogMessageCallback (the message as is).
+    Fmi3(LogMessageFn),
+}
+
 /// The host's logger callback, its environment and the instance name.
 #[derive(Clone)]
 pub struct Sink {
-    callback: Option<LoggerFn>,
+    callback: Option<Callback>,
     env: ComponentEnvironment,
     name: CString,
+    standard: Standard,
 }
 
 impl Sink {
-    /// The sink of instance `name` with the host's callbacks.
+    /// The sink of FMI 2 instance `name` with the host's callbacks.
     pub fn new(callbacks: &CallbackFunctions, name: &str) -> Sink {
-        Sink { callback: callbacks.logger, env: callbacks.component_environment, name: c_text(name) }
+        let (callback, env) = (callbacks.logger.map(Callback::Fmi2), callbacks.component_environment);
+        Sink { callback, env, name: c_text(name), standard: Standard::Fmi2 }
+    }
+
+    /// The sink of FMI 3 instance `name` with the host's `logMessage` and
+    /// `instanceEnvironment`.
+    pub fn fmi3(log: Option<LogMessageFn>, env: ComponentEnvironment, name: &str) -> Sink {
+        Sink { callback: log.map(Callback::Fmi3), env, name: c_text(name), standard: Standard::Fmi3 }
+    }
+
+    /// The FMI version of the instance (whose function names its messages use).
+    pub fn standard(&self) -> Standard {
+        self.standard
     }
 
     /// Hand `msg` to the host's logger (nothing when it gave none).
     pub fn emit(&self, status: Status, msg: &str) {
-        if let Some(cb) = self.callback {
-            let text = c_text(msg);
+        let text = c_text(msg);
+        match self.callback {
+            None => {}
             // SAFETY: `cb` is the host's fmi2CallbackLogger; every pointer passed is a valid
             // NUL-terminated string living across the call, and the format "%s" consumes
             // exactly the one string argument given.
-            unsafe {
+            Some(Callback::Fmi2(cb)) => unsafe {
                 cb(
                     self.env,
                     self.name.as_ptr(),
@@ -129,7 +153,12 @@ impl Sink {
                     c"%s".as_ptr(),
                     text.as_ptr(),
                 )
-            };
+            },
+            // SAFETY: `cb` is the host's fmi3LogMessageCallback; the strings are valid and
+            // NUL-terminated across the call.
+            Some(Callback::Fmi3(cb)) => unsafe {
+                cb(self.env, status as libc::c_int, category(status).as_ptr(), text.as_ptr())
+            },
         }
     }
 }

@@ -1,8 +1,13 @@
-//! The FMI 2.0 Co-Simulation layer: a thin shell over the engine. It maps value
-//! references, enforces the FMI state machine, logs, and calls the engine; it computes
-//! nothing itself.
+//! The FMI Co-Simulation layer, what runs inside a host: one thin shell over the engine
+//! (handles, guard, state-machine table, instance, logger) under two tables of exports,
+//! FMI 2.0 (`exports_*`) and FMI 3.0 (`exports3_*`). It maps value references, enforces
+//! the state machine, logs, and calls the engine; it computes nothing itself. The
+//! build-time packer is [`crate::pack`].
 
 pub mod config;
+pub mod exports3_common;
+pub mod exports3_cs;
+pub mod exports3_other;
 pub mod exports_common;
 pub mod exports_cs;
 pub mod exports_me;

@@ -1,6 +1,8 @@
-//! The FMI 2.0 Co-Simulation state machine (4.2.4 State Machine of Calling Sequence from
-//! Master to Slave): one const table of the states in which each function may be called,
-//! and one guard every export runs first.
+//! The Co-Simulation state machines of FMI 2.0 (4.2.4 State Machine of Calling Sequence
+//! from Master to Slave) and FMI 3.0 (4.3 Co-Simulation state machine): one const table of
+//! each function's C names and the states in which it may be called, a column per FMI
+//! version (where the two differ, the table says so), and one guard every export runs
+//! first.
 
 /// A state of a Co-Simulation instance; each is one bit so a set of states is a mask.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -25,6 +27,9 @@ pub enum State {
     /// fatal: after a panic in a function that may have left the engine half-updated;
     /// only fmi2FreeInstance is allowed.
     Fatal = 128,
+    /// FMI 3 Event Mode (after fmi3ExitInitializationMode when the host uses event mode,
+    /// or fmi3EnterEventMode): nothing happens there, the model has no events.
+    EventMode = 256,
 }
 
 impl State {
@@ -33,8 +38,9 @@ impl State {
         self as u32
     }
 
-    /// Every state, for decoding a serialized state.
-    pub const ALL: [State; 8] = [
+    /// Every state, for decoding a serialized state (new states go last: a state's
+    /// position is its code).
+    pub const ALL: [State; 9] = [
         State::Instantiated,
         State::InitializationMode,
         State::StepComplete,
@@ -43,6 +49,7 @@ impl State {
         State::Terminated,
         State::Error,
         State::Fatal,
+        State::EventMode,
     ];
 }
 
@@ -54,8 +61,11 @@ const CANC: u32 = State::StepCanceled.bit();
 const TERM: u32 = State::Terminated.bit();
 const ERR: u32 = State::Error.bit();
 const FATAL: u32 = State::Fatal.bit();
+const EVENT: u32 = State::EventMode.bit();
 /// Every state but Fatal.
-const ALIVE: u32 = INST | INIT | DONE | FAIL | CANC | TERM | ERR;
+const ALIVE: u32 = INST | INIT | DONE | FAIL | CANC | TERM | ERR | EVENT;
+/// Not a function of this FMI version.
+const NONE: u32 = 0;
 /// States with values to read.
 const READABLE: u32 = INIT | DONE | FAIL | CANC | TERM | ERR;
 
@@ -124,58 +134,119 @@ pub enum Func {
     GetBooleanStatus,
     /// `fmi2GetStringStatus`.
     GetStringStatus,
+    /// `fmi3GetAdjointDerivative`.
+    GetAdjointDerivative,
+    /// `fmi3EnterEventMode`.
+    EnterEventMode,
+    /// `fmi3EnterStepMode`.
+    EnterStepMode,
+    /// `fmi3UpdateDiscreteStates`.
+    UpdateDiscreteStates,
+    /// The FMI 3 functions of what this FMU does not have (other variable types, clocks,
+    /// configuration mode, Model Exchange, …): refused in any state with a message naming
+    /// the function.
+    Unsupported,
 }
 
 /// One row of the table.
 pub struct Rule {
     /// The function of this row; rows are in `Func` order, so `RULES[f as usize].func == f`.
     pub func: Func,
-    /// The C name, used in every message.
-    pub name: &'static str,
-    /// States in which the call is legal.
-    pub allowed: u32,
+    /// The C name in FMI 2 ("" if none), used in every message.
+    pub name2: &'static str,
+    /// States in which the FMI 2 call is legal.
+    pub allowed2: u32,
+    /// The C name in FMI 3 ("" if none).
+    pub name3: &'static str,
+    /// States in which the FMI 3 call is legal.
+    pub allowed3: u32,
     /// A panic inside may have left the engine half-updated: the instance turns Fatal.
     pub panic_is_fatal: bool,
 }
 
-const fn rule(func: Func, name: &'static str, allowed: u32, panic_is_fatal: bool) -> Rule {
-    Rule { func, name, allowed, panic_is_fatal }
+const fn rule(
+    func: Func,
+    (name2, allowed2): (&'static str, u32),
+    (name3, allowed3): (&'static str, u32),
+    panic_is_fatal: bool,
+) -> Rule {
+    Rule { func, name2, allowed2, name3, allowed3, panic_is_fatal }
 }
 
-/// Allowed states per function, in `Func` order (masks follow the FMI 2.0 CS state
-/// machine as modelica/Reference-FMUs encodes it).
-pub const RULES: [Rule; 31] = [
-    rule(Func::SetDebugLogging, "fmi2SetDebugLogging", ALIVE, false),
-    rule(Func::FreeInstance, "fmi2FreeInstance", ALIVE | FATAL, false),
-    rule(Func::SetupExperiment, "fmi2SetupExperiment", INST, false),
-    rule(Func::EnterInitializationMode, "fmi2EnterInitializationMode", INST, false),
-    rule(Func::ExitInitializationMode, "fmi2ExitInitializationMode", INIT, true),
-    rule(Func::Terminate, "fmi2Terminate", DONE | FAIL | ERR, false),
-    rule(Func::Reset, "fmi2Reset", ALIVE, true),
-    rule(Func::GetReal, "fmi2GetReal", READABLE, false),
-    rule(Func::GetInteger, "fmi2GetInteger", READABLE, false),
-    rule(Func::GetBoolean, "fmi2GetBoolean", READABLE, false),
-    rule(Func::GetString, "fmi2GetString", READABLE, false),
-    rule(Func::SetReal, "fmi2SetReal", INST | INIT | DONE, true),
-    rule(Func::SetInteger, "fmi2SetInteger", INST | INIT | DONE, false),
-    rule(Func::SetBoolean, "fmi2SetBoolean", INST | INIT | DONE, false),
-    rule(Func::SetString, "fmi2SetString", INST | INIT | DONE, false),
-    rule(Func::GetFmuState, "fmi2GetFMUstate", ALIVE, false),
-    rule(Func::SetFmuState, "fmi2SetFMUstate", ALIVE, true),
-    rule(Func::FreeFmuState, "fmi2FreeFMUstate", ALIVE, false),
-    rule(Func::SerializedFmuStateSize, "fmi2SerializedFMUstateSize", ALIVE, false),
-    rule(Func::SerializeFmuState, "fmi2SerializeFMUstate", ALIVE, false),
-    rule(Func::DeSerializeFmuState, "fmi2DeSerializeFMUstate", ALIVE, false),
-    rule(Func::GetDirectionalDerivative, "fmi2GetDirectionalDerivative", READABLE, false),
-    rule(Func::SetRealInputDerivatives, "fmi2SetRealInputDerivatives", INST | INIT | DONE, true),
-    rule(Func::GetRealOutputDerivatives, "fmi2GetRealOutputDerivatives", DONE | FAIL | CANC | TERM | ERR, false),
-    rule(Func::DoStep, "fmi2DoStep", DONE, true),
-    rule(Func::CancelStep, "fmi2CancelStep", DONE | FAIL | CANC, false),
-    rule(Func::GetStatus, "fmi2GetStatus", DONE | FAIL | CANC | TERM, false),
-    rule(Func::GetRealStatus, "fmi2GetRealStatus", DONE | FAIL | CANC | TERM, false),
-    rule(Func::GetIntegerStatus, "fmi2GetIntegerStatus", DONE | FAIL | CANC | TERM, false),
-    rule(Func::GetBooleanStatus, "fmi2GetBooleanStatus", DONE | FAIL | CANC | TERM, false),
-    rule(Func::GetStringStatus, "fmi2GetStringStatus", DONE | FAIL | CANC | TERM, false),
+/// States with values to read in FMI 3 (Event Mode too).
+const READABLE3: u32 = READABLE | EVENT;
+/// States in which FMI 3 hosts set values.
+const SETTABLE3: u32 = INST | INIT | DONE | EVENT;
+
+/// Allowed states per function, in `Func` order: FMI 2 masks follow the FMI 2.0 CS state
+/// machine, FMI 3 masks the FMI 3.0 CS one, both as modelica/Reference-FMUs encodes them.
+pub const RULES: [Rule; 36] = [
+    rule(Func::SetDebugLogging, ("fmi2SetDebugLogging", ALIVE), ("fmi3SetDebugLogging", ALIVE), false),
+    rule(Func::FreeInstance, ("fmi2FreeInstance", ALIVE | FATAL), ("fmi3FreeInstance", ALIVE | FATAL), false),
+    rule(Func::SetupExperiment, ("fmi2SetupExperiment", INST), ("", NONE), false),
+    rule(
+        Func::EnterInitializationMode,
+        ("fmi2EnterInitializationMode", INST),
+        ("fmi3EnterInitializationMode", INST),
+        false,
+    ),
+    rule(
+        Func::ExitInitializationMode,
+        ("fmi2ExitInitializationMode", INIT),
+        ("fmi3ExitInitializationMode", INIT),
+        true,
+    ),
+    rule(Func::Terminate, ("fmi2Terminate", DONE | FAIL | ERR), ("fmi3Terminate", DONE | FAIL | ERR | EVENT), false),
+    rule(Func::Reset, ("fmi2Reset", ALIVE), ("fmi3Reset", ALIVE), true),
+    rule(Func::GetReal, ("fmi2GetReal", READABLE), ("fmi3GetFloat64", READABLE3), false),
+    rule(Func::GetInteger, ("fmi2GetInteger", READABLE), ("fmi3GetInt32", READABLE3), false),
+    rule(Func::GetBoolean, ("fmi2GetBoolean", READABLE), ("fmi3GetBoolean", READABLE3), false),
+    rule(Func::GetString, ("fmi2GetString", READABLE), ("fmi3GetString", READABLE3), false),
+    rule(Func::SetReal, ("fmi2SetReal", INST | INIT | DONE), ("fmi3SetFloat64", SETTABLE3), true),
+    rule(Func::SetInteger, ("fmi2SetInteger", INST | INIT | DONE), ("fmi3SetInt32", SETTABLE3), false),
+    rule(Func::SetBoolean, ("fmi2SetBoolean", INST | INIT | DONE), ("fmi3SetBoolean", SETTABLE3), false),
+    rule(Func::SetString, ("fmi2SetString", INST | INIT | DONE), ("fmi3SetString", SETTABLE3), false),
+    rule(Func::GetFmuState, ("fmi2GetFMUstate", ALIVE), ("fmi3GetFMUState", ALIVE), false),
+    rule(Func::SetFmuState, ("fmi2SetFMUstate", ALIVE), ("fmi3SetFMUState", ALIVE), true),
+    rule(Func::FreeFmuState, ("fmi2FreeFMUstate", ALIVE), ("fmi3FreeFMUState", ALIVE), false),
+    rule(
+        Func::SerializedFmuStateSize,
+        ("fmi2SerializedFMUstateSize", ALIVE),
+        ("fmi3SerializedFMUStateSize", ALIVE),
+        false,
+    ),
+    rule(Func::SerializeFmuState, ("fmi2SerializeFMUstate", ALIVE), ("fmi3SerializeFMUState", ALIVE), false),
+    rule(Func::DeSerializeFmuState, ("fmi2DeSerializeFMUstate", ALIVE), ("fmi3DeserializeFMUState", ALIVE), false),
+    rule(
+        Func::GetDirectionalDerivative,
+        ("fmi2GetDirectionalDerivative", READABLE),
+        ("fmi3GetDirectionalDerivative", INIT | DONE | FAIL | TERM | EVENT),
+        false,
+    ),
+    rule(Func::SetRealInputDerivatives, ("fmi2SetRealInputDerivatives", INST | INIT | DONE), ("", NONE), true),
+    rule(
+        Func::GetRealOutputDerivatives,
+        ("fmi2GetRealOutputDerivatives", DONE | FAIL | CANC | TERM | ERR),
+        ("fmi3GetOutputDerivatives", DONE | FAIL | TERM),
+        false,
+    ),
+    rule(Func::DoStep, ("fmi2DoStep", DONE), ("fmi3DoStep", DONE), true),
+    rule(Func::CancelStep, ("fmi2CancelStep", DONE | FAIL | CANC), ("", NONE), false),
+    rule(Func::GetStatus, ("fmi2GetStatus", DONE | FAIL | CANC | TERM), ("", NONE), false),
+    rule(Func::GetRealStatus, ("fmi2GetRealStatus", DONE | FAIL | CANC | TERM), ("", NONE), false),
+    rule(Func::GetIntegerStatus, ("fmi2GetIntegerStatus", DONE | FAIL | CANC | TERM), ("", NONE), false),
+    rule(Func::GetBooleanStatus, ("fmi2GetBooleanStatus", DONE | FAIL | CANC | TERM), ("", NONE), false),
+    rule(Func::GetStringStatus, ("fmi2GetStringStatus", DONE | FAIL | CANC | TERM), ("", NONE), false),
+    rule(
+        Func::GetAdjointDerivative,
+        ("", NONE),
+        ("fmi3GetAdjointDerivative", INIT | DONE | FAIL | TERM | EVENT),
+        false,
+    ),
+    rule(Func::EnterEventMode, ("", NONE), ("fmi3EnterEventMode", DONE), false),
+    rule(Func::EnterStepMode, ("", NONE), ("fmi3EnterStepMode", EVENT), false),
+    rule(Func::UpdateDiscreteStates, ("", NONE), ("fmi3UpdateDiscreteStates", EVENT), false),
+    rule(Func::Unsupported, ("", NONE), ("an FMI 3 function", ALIVE), false),
 ];
 
 impl Func {
@@ -184,17 +255,38 @@ impl Func {
         &RULES[self as usize]
     }
 
-    /// The C name.
+    /// The C name in FMI version `standard`.
+    pub fn name_in(self, standard: Standard) -> &'static str {
+        let r = self.rule();
+        match standard {
+            Standard::Fmi2 => r.name2,
+            Standard::Fmi3 => r.name3,
+        }
+    }
+
+    /// The C name (FMI 2's, else FMI 3's).
     pub fn name(self) -> &'static str {
-        self.rule().name
+        let r = self.rule();
+        if r.name2.is_empty() { r.name3 } else { r.name2 }
     }
 }
 
-/// The guard: `Err("fmi2X: not allowed in state Y")` when `func` is illegal in `state`.
-pub fn check(state: State, func: Func) -> Result<(), String> {
+/// The guard: `Err("fmiXY: not allowed in state Z")` when `func` is illegal in `state` for
+/// an instance of FMI version `standard`.
+pub fn check(state: State, func: Func, standard: Standard) -> Result<(), String> {
     let r = func.rule();
-    if r.allowed & state.bit() != 0 { Ok(()) } else { Err(format!("{}: not allowed in state {state:?}", r.name)) }
+    let allowed = match standard {
+        Standard::Fmi2 => r.allowed2,
+        Standard::Fmi3 => r.allowed3,
+    };
+    if allowed & state.bit() != 0 {
+        Ok(())
+    } else {
+        Err(format!("{}: not allowed in state {state:?}", func.name_in(standard)))
+    }
 }
+
+use super::variables::Standard;
 
 #[cfg(test)]
 mod tests {
@@ -203,14 +295,24 @@ mod tests {
     #[test]
     fn every_row_sits_at_its_function_index() {
         for (k, r) in RULES.iter().enumerate() {
-            assert_eq!(r.func as usize, k, "{}", r.name);
+            assert_eq!(r.func as usize, k, "{}", r.func.name());
         }
     }
 
     #[test]
     fn do_step_is_legal_only_after_initialization() {
-        assert!(check(State::StepComplete, Func::DoStep).is_ok());
-        let e = check(State::Instantiated, Func::DoStep).unwrap_err();
+        assert!(check(State::StepComplete, Func::DoStep, Standard::Fmi2).is_ok());
+        let e = check(State::Instantiated, Func::DoStep, Standard::Fmi2).unwrap_err();
         assert_eq!(e, "fmi2DoStep: not allowed in state Instantiated");
+        let e = check(State::EventMode, Func::DoStep, Standard::Fmi3).unwrap_err();
+        assert_eq!(e, "fmi3DoStep: not allowed in state EventMode");
+    }
+
+    #[test]
+    fn a_function_of_one_version_is_never_legal_in_the_other() {
+        for r in &RULES {
+            assert_eq!(r.name2.is_empty(), r.allowed2 == 0, "{}", r.name3);
+            assert_eq!(r.name3.is_empty(), r.allowed3 == 0, "{}", r.name2);
+        }
     }
 }

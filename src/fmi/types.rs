@@ -1,4 +1,6 @@
-//! FMI 2.0 C types (fmi2TypesPlatform.h, fmi2FunctionTypes.h) in Rust, with `libc` scalars.
+//! FMI 2.0 C types (fmi2TypesPlatform.h, fmi2FunctionTypes.h) in Rust, with `libc` scalars;
+//! FMI 3.0 shares them where the two agree (pointers, status values), and adds its own
+//! in `fmi3`'s exports.
 //! C enums the host passes in (fmi2Type, fmi2StatusKind) arrive as `c_int` and are checked,
 //! never transmuted.
 
@@ -65,6 +67,8 @@ pub const TERMINATED: c_int = 3;
 /// fmi2CallbackLogger: `(env, instanceName, status, category, message, ...)`; the message
 /// is a printf format, so it is always called with `"%s"` and the text.
 pub type LoggerFn = unsafe extern "C" fn(ComponentEnvironment, FmiString, c_int, FmiString, FmiString, ...);
+/// fmi3LogMessageCallback: `(instanceEnvironment, status, category, message)`.
+pub type LogMessageFn = unsafe extern "C" fn(ComponentEnvironment, c_int, FmiString, FmiString);
 /// fmi2CallbackAllocateMemory.
 pub type AllocateMemoryFn = unsafe extern "C" fn(size_t, size_t) -> *mut c_void;
 /// fmi2CallbackFreeMemory.

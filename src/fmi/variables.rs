@@ -15,6 +15,16 @@ use crate::linearize::{StateLayout, derivative_name};
 use crate::model::Model;
 use crate::model::units::per_second;
 
+/// The FMI version an FMU or instance follows; where the two differ, code says so
+/// with this.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Standard {
+    /// FMI 2.0.
+    Fmi2,
+    /// FMI 3.0.
+    Fmi3,
+}
+
 /// Name of the Integer parameter that bounds the integrator step attempts per fmi2DoStep.
 pub const MAX_STEPS_NAME: &str = "solver.maxSteps";
 
@@ -29,6 +39,8 @@ pub enum Causality {
     Output,
     /// Linearization states and their derivatives.
     Local,
+    /// The independent variable, time (FMI 3 only).
+    Independent,
 }
 
 /// What a value reference denotes in the engine.
@@ -56,6 +68,8 @@ pub enum Target {
     UserVariable(usize),
     /// `solver.maxSteps` (Integer, tunable): most integrator step attempts per fmi2DoStep.
     MaxSteps,
+    /// Time, the independent variable (FMI 3 only).
+    Time,
 }
 
 impl Target {
@@ -90,9 +104,10 @@ pub struct Variable {
     pub unknown: Option<usize>,
 }
 
-/// All FMI variables of a model whose FMU exposes the linearization states `lay`, in
-/// ModelVariables order (index + 1 = FMI index).
-pub fn variables(model: &Model, lay: &StateLayout) -> Vec<Variable> {
+/// All FMI variables of a model whose FMU (of FMI version `standard`) exposes the
+/// linearization states `lay`, in ModelVariables order (index + 1 = FMI 2 index). FMI 3
+/// adds the independent variable `time`, last.
+pub fn variables(model: &Model, lay: &StateLayout, standard: Standard) -> Vec<Variable> {
     let mut v = Vec::new();
     push_parameters(&mut v, model);
     push_inputs(&mut v, model);
@@ -102,6 +117,13 @@ pub fn variables(model: &Model, lay: &StateLayout) -> Vec<Variable> {
     push_differentials(&mut v, model, lay.positions.len() + lay.velocities.len());
     push_user_variables(&mut v, model);
     push_max_steps(&mut v);
+    if standard == Standard::Fmi3 {
+        let mut t = local("time".into(), v.len(), Target::Time);
+        t.causality = Causality::Independent;
+        t.unit = Some("s".into());
+        t.description = Some("Simulation time".into());
+        v.push(t);
+    }
     v
 }
 

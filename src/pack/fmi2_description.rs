@@ -5,13 +5,15 @@
 //! [`crate::linearize::structure`], mapping its indices (states as columns of A, inputs,
 //! parameters) to FMI variable indices.
 
-use crate::model::units::{self, BASE_NAMES};
 use std::collections::BTreeSet;
 use std::fmt::Write as _;
 
+use super::structure::unknowns;
+use super::xml::{attr_line, escape, real, with_state_starts, write_experiment, write_units};
+
 use crate::fmi::guid::{ENGINE_VERSION, guid, model_identifier};
-use crate::fmi::variables::{Causality, Target, Variable, variables};
-use crate::linearize::{Dependencies, FmuLinearization, ModelStructure, StateLayout, StateValues, for_fmu};
+use crate::fmi::variables::{Causality, Standard, Variable, variables};
+use crate::linearize::{FmuLinearization, ModelStructure, StateLayout, StateValues, for_fmu};
 use crate::model::Model;
 
 /// The modelDescription.xml that `mbfmu pack` writes for `model`, whose file text is
@@ -33,7 +35,7 @@ pub fn describe(
     structure: &ModelStructure,
     starts: &StateValues,
 ) -> String {
-    let vars = with_state_starts(variables(model, layout), model, layout, starts);
+    let vars = with_state_starts(variables(model, layout, Standard::Fmi2), model, layout, starts);
     let mut x = String::new();
     x.push_str("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
     x.push_str("<fmiModelDescription\n");
@@ -75,118 +77,6 @@ pub fn describe(
     x
 }
 
-/// `    name="value"` and a newline (attributes of a multi-line start tag).
-fn attr_line(x: &mut String, name: &str, value: &str) {
-    let _ = writeln!(x, "  {name}=\"{}\"", escape(value));
-}
-
-/// Escape text for a double-quoted XML attribute value.
-fn escape(s: &str) -> String {
-    let mut out = String::with_capacity(s.len());
-    for c in s.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&apos;"),
-            '\t' => out.push_str("&#9;"),
-            '\n' => out.push_str("&#10;"),
-            '\r' => out.push_str("&#13;"),
-            // Not representable in XML 1.0: drop.
-            c if (c as u32) < 0x20 => {}
-            c => out.push(c),
-        }
-    }
-    out
-}
-
-/// An `xs:double` literal that reads back to the same `f64`: the shorter of Rust's two
-/// round-trip formats (`0.5`, `1e-6`), `INF`, `-INF` or `NaN`.
-fn real(v: f64) -> String {
-    if v.is_nan() {
-        return "NaN".into();
-    }
-    if v.is_infinite() {
-        return if v > 0.0 { "INF".into() } else { "-INF".into() };
-    }
-    let (display, debug) = (format!("{v}"), format!("{v:?}"));
-    if debug.len() < display.len() { debug } else { display }
-}
-
-fn write_units(x: &mut String, vars: &[Variable]) {
-    let units: BTreeSet<&str> = vars.iter().filter_map(|v| v.unit.as_deref()).collect();
-    if units.is_empty() {
-        return;
-    }
-    x.push_str("  <UnitDefinitions>\n");
-    for u in units {
-        match base_unit(u) {
-            Some((exps, factor)) => {
-                let _ = writeln!(x, "    <Unit name=\"{}\">", escape(u));
-                x.push_str("      <BaseUnit");
-                for (name, e) in BASE_NAMES.iter().zip(exps) {
-                    if e != 0 {
-                        let _ = write!(x, " {name}=\"{e}\"");
-                    }
-                }
-                if factor != 1.0 {
-                    let _ = write!(x, " factor=\"{}\"", real(factor));
-                }
-                x.push_str("/>\n    </Unit>\n");
-            }
-            None => {
-                let _ = writeln!(x, "    <Unit name=\"{}\"/>", escape(u));
-            }
-        }
-    }
-    x.push_str("  </UnitDefinitions>\n");
-}
-
-/// SI exponents (in [`BASE_NAMES`] order) and factor of a unit; `None` for an unparsable
-/// or dimensionless one (no `<BaseUnit>` then).
-fn base_unit(unit: &str) -> Option<([i32; 8], f64)> {
-    let u = units::parse(unit).ok()?;
-    (u.exps.iter().any(|e| *e != 0)).then_some((u.exps, u.factor))
-}
-
-fn write_experiment(x: &mut String, model: &Model) {
-    let e = &model.experiment;
-    let attrs: Vec<String> =
-        [("startTime", e.start), ("stopTime", e.stop), ("tolerance", e.tolerance), ("stepSize", e.step)]
-            .into_iter()
-            .filter_map(|(n, v)| v.map(|v| format!(" {n}=\"{}\"", real(v))))
-            .collect();
-    if !attrs.is_empty() {
-        let _ = writeln!(x, "  <DefaultExperiment{}/>", attrs.concat());
-    }
-}
-
-/// The states' start values: those set when packing as set, others S, W (`der(S)` where
-/// it is W) from `starts` (the assembled model), X from the model's `start`. Other locals (derivatives, user variables) have none.
-fn with_state_starts(
-    mut vars: Vec<Variable>,
-    model: &Model,
-    layout: &StateLayout,
-    starts: &StateValues,
-) -> Vec<Variable> {
-    for v in &mut vars {
-        // A state given a start value when packing (`--set`) has exactly that start.
-        if let Some((_, x)) = model.state_starts.iter().find(|(n, _)| *n == v.name) {
-            v.start = Some(*x);
-            continue;
-        }
-        v.start = match v.target {
-            Target::State(k) => starts.s.get(k).copied(),
-            Target::StateDerivative(k) if layout.velocity_of_state(k).is_some() => starts.sd.get(k).copied(),
-            Target::Velocity(j) => starts.w.get(j).copied(),
-            Target::Diff(k) => Some(model.differentials[k].start.value),
-            _ => v.start,
-        };
-    }
-    vars
-}
-
 fn write_variable(x: &mut String, index: usize, v: &Variable) {
     let (causality, variability, initial) = match v.causality {
         // Solver settings may change between steps; model parameters only before
@@ -200,6 +90,7 @@ fn write_variable(x: &mut String, index: usize, v: &Variable) {
         // every state stays an InitialUnknown.)
         Causality::Local if v.start.is_some() => ("local", "continuous", Some("approx")),
         Causality::Local => ("local", "continuous", Some("calculated")),
+        Causality::Independent => ("independent", "continuous", None),
     };
     let _ = writeln!(x, "    <!-- index {index} -->");
     let _ = write!(
@@ -249,68 +140,25 @@ fn unknown(x: &mut String, index: usize, deps: &BTreeSet<usize>) {
 }
 
 fn write_structure(x: &mut String, model: &Model, vars: &[Variable], st: &ModelStructure) {
-    // FMI index (1-based ModelVariables position) of each parameter, input and state
-    // (column of A).
-    let mut param_index = vec![0; model.parameters.len()];
-    let mut input_index = vec![0; model.inputs.len()];
-    let mut state_index = vec![0; vars.iter().filter(|v| v.known.is_some()).count()];
-    for (k, v) in vars.iter().enumerate() {
-        match v.target {
-            Target::Parameter(p) => param_index[p] = k + 1,
-            Target::Input(i) => input_index[i] = k + 1,
-            _ => {}
-        }
-        if let Some(c) = v.known {
-            state_index[c] = k + 1;
-        }
-    }
-    let fmi = |d: &Dependencies| -> BTreeSet<usize> {
-        let states = d.states.iter().map(|&c| state_index[c]);
-        states.chain(d.inputs.iter().map(|&i| input_index[i])).collect()
-    };
-    let none = Dependencies::default();
-    let mut unknowns: Vec<(usize, &Dependencies)> = Vec::new(); // (index, at communication points)
-    let mut derivatives = Vec::new();
-    for (k, v) in vars.iter().enumerate() {
-        let d = match v.target {
-            Target::Output(o) => &st.outputs[o],
-            Target::StateDerivative(i) => &st.position_rates[i],
-            Target::VelocityDerivative(j) => &st.velocity_rates[j],
-            Target::DiffDerivative(i) => &st.diff_rates[i],
-            Target::State(_) | Target::Velocity(_) | Target::Diff(_) => &none,
-            _ => continue,
-        };
-        if matches!(v.target, Target::StateDerivative(_) | Target::VelocityDerivative(_) | Target::DiffDerivative(_)) {
-            derivatives.push((k + 1, d));
-        }
-        unknowns.push((k + 1, d));
-    }
-    if unknowns.is_empty() {
+    let u = unknowns(model, vars, st);
+    let index = |set: &BTreeSet<usize>| -> BTreeSet<usize> { set.iter().map(|k| k + 1).collect() };
+    if u.initial.is_empty() {
         x.push_str("  <ModelStructure/>\n");
         return;
     }
     x.push_str("  <ModelStructure>\n");
-    let outputs: Vec<&(usize, &Dependencies)> =
-        unknowns.iter().filter(|(i, _)| matches!(vars[i - 1].target, Target::Output(_))).collect();
-    if !outputs.is_empty() {
-        x.push_str("    <Outputs>\n");
-        for (index, d) in outputs {
-            unknown(x, *index, &fmi(d));
+    for (tag, list) in [("Outputs", &u.outputs), ("Derivatives", &u.derivatives)] {
+        if !list.is_empty() {
+            let _ = writeln!(x, "    <{tag}>");
+            for (k, d) in list {
+                unknown(x, k + 1, &index(d));
+            }
+            let _ = writeln!(x, "    </{tag}>");
         }
-        x.push_str("    </Outputs>\n");
-    }
-    if !derivatives.is_empty() {
-        x.push_str("    <Derivatives>\n");
-        for (index, d) in &derivatives {
-            unknown(x, *index, &fmi(d));
-        }
-        x.push_str("    </Derivatives>\n");
     }
     x.push_str("    <InitialUnknowns>\n");
-    for (index, d) in &unknowns {
-        let init = st.initial(d);
-        let params = init.parameters.iter().map(|&p| param_index[p]);
-        unknown(x, *index, &params.chain(init.inputs.iter().map(|&i| input_index[i])).collect());
+    for (k, d) in &u.initial {
+        unknown(x, k + 1, &index(d));
     }
     x.push_str("    </InitialUnknowns>\n  </ModelStructure>\n");
 }
@@ -318,21 +166,6 @@ fn write_structure(x: &mut String, model: &Model, vars: &[Variable], st: &ModelS
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn units_decompose_into_si_exponents() {
-        assert_eq!(base_unit("N.m"), Some(([1, 2, -2, 0, 0, 0, 0, 0], 1.0)));
-        assert_eq!(base_unit("N.m.s/rad"), Some(([1, 2, -1, 0, 0, 0, 0, -1], 1.0)));
-        assert_eq!(base_unit("kg.m2"), Some(([1, 2, 0, 0, 0, 0, 0, 0], 1.0)));
-        assert_eq!(base_unit("m/s2"), Some(([0, 1, -2, 0, 0, 0, 0, 0], 1.0)));
-        assert_eq!(base_unit("N.s/m"), Some(([1, 0, -1, 0, 0, 0, 0, 0], 1.0)));
-        assert_eq!(base_unit("mol"), Some(([0, 0, 0, 0, 0, 1, 0, 0], 1.0)));
-        assert_eq!(base_unit("furlong"), None);
-        assert_eq!(base_unit("m/s/s"), None);
-        assert_eq!(base_unit(""), None);
-        assert_eq!(base_unit("m/m"), None);
-        assert_eq!(base_unit("mm"), Some(([0, 1, 0, 0, 0, 0, 0, 0], 1e-3)));
-    }
 
     /// A slider with three inputs: `u` drives an sforce, `v` a gforce, `w` only an output.
     const INPUTS: &str = r#"<multibody name="inputs" version="1">
@@ -411,16 +244,5 @@ mod tests {
             assert!(real.contains(&format!("unit=\"{unit}\"")), "{var}: {real}");
         }
         assert!(xml.contains(r#"<Unit name="rad/s2">"#), "{xml}");
-    }
-
-    #[test]
-    fn reals_round_trip_and_escaping() {
-        for v in [0.0, 0.5, 1e-6, 9.80665, 170.0 * std::f64::consts::PI / 180.0, 1e300, -2.5e-12] {
-            assert_eq!(real(v).parse::<f64>().ok(), Some(v), "{}", real(v));
-        }
-        assert_eq!(real(1e-6), "1e-6");
-        assert_eq!(real(8.2), "8.2");
-        assert_eq!(real(0.0), "0");
-        assert_eq!(escape("a<b & \"c\"\n"), "a&lt;b &amp; &quot;c&quot;&#10;");
     }
 }

@@ -27,6 +27,9 @@
 
 pub mod bundle;
 pub mod fmi2_description;
+pub mod fmi3_description;
+mod structure;
+mod xml;
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -37,17 +40,27 @@ use zip::write::SimpleFileOptions;
 use crate::dae::StartValues;
 use crate::fmi::guid::{guid, guid_with, model_identifier};
 use crate::fmi::resources::{LAYOUT_FILE, START_VALUES_FILE};
+use crate::fmi::variables::Standard;
 use crate::linearize::{FmuLinearization, StateLayout, for_fmu};
 use crate::model::overrides::start_values_text;
 use crate::model::{ModelError, load_str};
 
-/// FMI platform folder under `binaries/`.
+/// FMI 3 platform tuple under `binaries/` (`<arch>-<os>`: `x86_64-linux`, `aarch64-darwin`, …).
+pub fn platform_tuple() -> String {
+    let os = match std::env::consts::OS {
+        "macos" => "darwin",
+        os => os,
+    };
+    format!("{}-{os}", std::env::consts::ARCH)
+}
+
+/// FMI 2 platform folder under `binaries/`.
 #[cfg(target_os = "macos")]
 pub const PLATFORM: &str = "darwin64";
-/// FMI platform folder under `binaries/`.
+/// FMI 2 platform folder under `binaries/`.
 #[cfg(target_os = "windows")]
 pub const PLATFORM: &str = "win64";
-/// FMI platform folder under `binaries/`.
+/// FMI 2 platform folder under `binaries/`.
 #[cfg(not(any(target_os = "macos", target_os = "windows")))]
 pub const PLATFORM: &str = "linux64";
 
@@ -155,7 +168,7 @@ pub fn library() -> Result<Vec<u8>, PackError> {
 }
 
 /// Load the model and gather every file of its FMU, with the start values `set`.
-fn contents(model_path: &Path, set: &[(String, f64)]) -> Result<Contents, PackError> {
+fn contents(model_path: &Path, set: &[(String, f64)], standard: Standard) -> Result<Contents, PackError> {
     let label = model_path.display().to_string();
     let bytes = std::fs::read(model_path).map_err(|e| ModelError {
         file: label.clone(),
@@ -180,7 +193,12 @@ fn contents(model_path: &Path, set: &[(String, f64)]) -> Result<Contents, PackEr
     let lib = library()?;
     let FmuLinearization { layout, structure, starts } = for_fmu(&model);
     let guid = guid_with(&base, text, &start_values);
-    let xml = fmi2_description::describe(&model, &guid, &layout, &structure, &starts);
+    let (xml, platform) = match standard {
+        Standard::Fmi2 => {
+            (fmi2_description::describe(&model, &guid, &layout, &structure, &starts), PLATFORM.to_string())
+        }
+        Standard::Fmi3 => (fmi3_description::describe(&model, &guid, &layout, &structure, &starts), platform_tuple()),
+    };
     let warnings = layout
         .missing
         .iter()
@@ -188,7 +206,7 @@ fn contents(model_path: &Path, set: &[(String, f64)]) -> Result<Contents, PackEr
         .collect();
     let mut files = vec![
         ("modelDescription.xml".to_string(), xml.into_bytes()),
-        (format!("binaries/{PLATFORM}/{id}.{LIB_EXT}"), lib),
+        (format!("binaries/{platform}/{id}.{LIB_EXT}"), lib),
         ("resources/model.xml".to_string(), bytes.clone()),
         (format!("resources/{LAYOUT_FILE}"), layout.to_text(&guid).into_bytes()),
     ];
@@ -249,7 +267,7 @@ pub fn layout_file(model_text: &str, label: &str) -> Result<(Vec<u8>, Option<Str
 
 /// Write the FMU of the model file `model_path` as the zip archive `out` (replacing it).
 pub fn pack_fmu(model_path: &Path, out: &Path) -> Result<Packed, PackError> {
-    let c = contents(model_path, &[])?;
+    let c = contents(model_path, &[], Standard::Fmi2)?;
     write_zip(&c, out)?;
     Ok(c.packed)
 }
@@ -257,25 +275,26 @@ pub fn pack_fmu(model_path: &Path, out: &Path) -> Result<Packed, PackError> {
 /// Write the FMU of the model file `model_path` unzipped into the directory `dir`
 /// (created if needed; files of the same names are replaced).
 pub fn pack_dir(model_path: &Path, dir: &Path) -> Result<Packed, PackError> {
-    let c = contents(model_path, &[])?;
+    let c = contents(model_path, &[], Standard::Fmi2)?;
     write_dir(&c, dir)?;
     Ok(c.packed)
 }
 
 /// Pack both ways at once (either may be `None`); the model is loaded once.
 pub fn pack(model_path: &Path, fmu: Option<&Path>, dir: Option<&Path>) -> Result<Packed, PackError> {
-    pack_with(model_path, &[], fmu, dir)
+    pack_with(model_path, &[], Standard::Fmi2, fmu, dir)
 }
 
 /// [`pack`] with the start values `set` (`NAME=VALUE` pairs, [`crate::model::overrides`])
-/// instead of the model file's values.
+/// instead of the model file's values, as an FMU of FMI version `standard`.
 pub fn pack_with(
     model_path: &Path,
     set: &[(String, f64)],
+    standard: Standard,
     fmu: Option<&Path>,
     dir: Option<&Path>,
 ) -> Result<Packed, PackError> {
-    let c = contents(model_path, set)?;
+    let c = contents(model_path, set, standard)?;
     if let Some(out) = fmu {
         write_zip(&c, out)?;
     }

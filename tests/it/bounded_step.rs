@@ -81,7 +81,7 @@ fn initialize(c: Component, tol: f64) {
 /// Value reference of variable `name` of the model `text`.
 fn vr(text: &str, name: &str) -> u32 {
     let model = load_str(text, "model.xml").unwrap();
-    variables(&model, &StateLayout::at_start(&model))
+    variables(&model, &StateLayout::at_start(&model), mbfmu::fmi::variables::Standard::Fmi2)
         .iter()
         .find(|v| v.name == name)
         .unwrap_or_else(|| panic!("no variable {name}"))
@@ -111,7 +111,7 @@ fn last_time(c: Component) -> f64 {
 fn solver_max_steps_is_the_last_variable_an_integer_tunable_parameter() {
     for text in [toggle_text(), model_text("cart_pendulum_pid.xml")] {
         let model = load_str(&text, "model.xml").unwrap();
-        let vars = variables(&model, &StateLayout::at_start(&model));
+        let vars = variables(&model, &StateLayout::at_start(&model), mbfmu::fmi::variables::Standard::Fmi2);
         let last = vars.last().unwrap();
         assert_eq!(last.name, MAX_STEPS_NAME);
         assert_eq!(last.value_reference as usize, vars.len() - 1, "value reference = index");

@@ -211,7 +211,11 @@ fn pack_set_makes_the_values_the_fmus_start_values() {
     sim.advance(0.5).unwrap();
     let names = sim.output_names();
     let want = sim.outputs().unwrap();
-    let vars = mbfmu::fmi::variables::variables(&m, &mbfmu::linearize::StateLayout::at_start(&m));
+    let vars = mbfmu::fmi::variables::variables(
+        &m,
+        &mbfmu::linearize::StateLayout::at_start(&m),
+        mbfmu::fmi::variables::Standard::Fmi2,
+    );
     let vr = |n: &str| vars.iter().find(|v| v.name == n).unwrap().value_reference;
     let out_vrs: Vec<u32> = names.iter().map(|n| vr(n)).collect();
 
@@ -304,6 +308,7 @@ fn pack_set_on_a_state_is_the_fmus_start_and_a_host_value_replaces_it() {
     let vars = mbfmu::fmi::variables::variables(
         &mbfmu::model::parse::load_str(&model_text("pendulum.xml"), "p.xml").unwrap(),
         &mbfmu::fmi::resources::read_layout(&dir.join("resources"), &guid_of(&xml)).unwrap(),
+        mbfmu::fmi::variables::Standard::Fmi2,
     );
     let vr = |n: &str| vars.iter().find(|v| v.name == n).unwrap().value_reference;
     for host_value in [None, Some(-2.0)] {

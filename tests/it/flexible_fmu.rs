@@ -75,7 +75,11 @@ fn the_fmu_of_a_flexible_model_carries_its_data_and_linearizes_like_the_engine()
     assert_eq!(lin.states.len(), 8, "{:?}", lin.states);
 
     // The FMU, stepped the same way.
-    let vars = mbfmu::fmi::variables::variables(&m, &mbfmu::linearize::StateLayout::at_start(&m));
+    let vars = mbfmu::fmi::variables::variables(
+        &m,
+        &mbfmu::linearize::StateLayout::at_start(&m),
+        mbfmu::fmi::variables::Standard::Fmi2,
+    );
     let path = unzipped.join("resources").display().to_string().replace('%', "%25").replace(' ', "%20");
     let (name, g, uri) = (c"flex", CString::new(guid).unwrap(), CString::new(format!("file://{path}")).unwrap());
     // SAFETY: valid NUL-terminated strings; the host's callbacks.

@@ -92,7 +92,11 @@ fn rewinding_through_fmu_states_and_serialized_bytes_reproduces_outputs_bit_for_
     let text = model_text("double_pendulum.xml");
     let c = initialized(&text, 1e-8, &[]);
     let m = mbfmu::model::parse::load_str(&text, "m").unwrap();
-    let vars = mbfmu::fmi::variables::variables(&m, &mbfmu::linearize::StateLayout::at_start(&m));
+    let vars = mbfmu::fmi::variables::variables(
+        &m,
+        &mbfmu::linearize::StateLayout::at_start(&m),
+        mbfmu::fmi::variables::Standard::Fmi2,
+    );
     // Every Real variable (the last one, solver.maxSteps, is an Integer).
     let outs: Vec<u32> = vars.iter().filter(|v| !v.target.is_integer()).map(|v| v.value_reference).collect();
     let t1 = step(c, 0.0, 0.1, 5);
@@ -369,7 +373,7 @@ fn a_panic_inside_an_export_becomes_fatal_when_the_engine_may_be_corrupt_and_err
 fn lin_refs(text: &str) -> (Vec<u32>, Vec<u32>) {
     use mbfmu::fmi::variables::{Causality, variables};
     let m = mbfmu::model::parse::load_str(text, "model.xml").unwrap();
-    let vars = variables(&m, &mbfmu::linearize::StateLayout::at_start(&m));
+    let vars = variables(&m, &mbfmu::linearize::StateLayout::at_start(&m), mbfmu::fmi::variables::Standard::Fmi2);
     let pick = |f: &dyn Fn(&mbfmu::fmi::variables::Variable) -> bool| {
         vars.iter().filter(|v| f(v)).map(|v| v.value_reference).collect::<Vec<u32>>()
     };

@@ -79,7 +79,7 @@ fn mbfmu_linearize_selects_the_states_the_fmu_lists_for_every_model() {
         // The FMU's states: its layout resource through variables(), as an instance sees them.
         let layout = read_layout(&out.join("resources"), &guid_of(&path)).unwrap_or_else(|e| panic!("{e}"));
         let model = load_file(&path).unwrap_or_else(|e| panic!("{e}"));
-        let fmu = fmu_states(&variables(&model, &layout));
+        let fmu = fmu_states(&variables(&model, &layout, mbfmu::fmi::variables::Standard::Fmi2));
         let xml = std::fs::read_to_string(out.join("modelDescription.xml")).expect("written");
         for name in &fmu {
             assert!(xml.contains(&format!("<ScalarVariable name=\"{name}\"")), "{stem}: {name} in modelDescription");
@@ -119,7 +119,7 @@ fn velocity_states_relate_to_position_states_by_index() {
         let rebuilt: Vec<Option<usize>> = (0..again.velocities.len()).map(|j| again.state_of_velocity(j)).collect();
         assert_eq!(rebuilt, relation, "{name}");
         // der(S_k) is the variable of W_j = Ṡ_k; the other velocity states have their own.
-        let vars = variables(&model, &layout);
+        let vars = variables(&model, &layout, mbfmu::fmi::variables::Standard::Fmi2);
         for (j, k) in relation.iter().enumerate() {
             let w = vars.iter().find(|v| v.known == Some(sel.states.len() + j)).expect("a W variable");
             match k {

@@ -85,7 +85,8 @@ fn models() -> Vec<Model> {
             let name = path.file_stem().unwrap().to_string_lossy().to_string();
             let (_, uri) = resources_of(path, "sequences");
             let m = mbfmu::model::load_file(path).unwrap();
-            let vars = variables(&m, &mbfmu::linearize::StateLayout::at_start(&m));
+            let vars =
+                variables(&m, &mbfmu::linearize::StateLayout::at_start(&m), mbfmu::fmi::variables::Standard::Fmi2);
             let vr = |f: &dyn Fn(&mbfmu::fmi::variables::Variable) -> bool| {
                 vars.iter().filter(|v| f(v)).map(|v| v.value_reference).collect::<Vec<u32>>()
             };

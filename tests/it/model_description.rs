@@ -1,6 +1,7 @@
 //! The modelDescription.xml of every example model equals its golden file in
-//! `modelDescription/`, except the `guid` and `generationTool` attributes (they carry the
-//! engine fingerprint, which changes with every source edit).
+//! `modelDescription/` (FMI 2) and `modelDescription/fmi3/` (FMI 3), except the `guid`
+//! (`instantiationToken`) and `generationTool` attributes (they carry the engine
+//! fingerprint, which changes with every source edit).
 //!
 //! After an intended change, regenerate the golden files with
 //! `MBFMU_BLESS=1 cargo test --release --test it model_description::` and review the diff.
@@ -9,7 +10,7 @@ use std::path::Path;
 
 use crate::common::{model_files, root};
 use mbfmu::model::load_file;
-use mbfmu::pack::fmi2_description::write;
+use mbfmu::pack::{fmi2_description, fmi3_description};
 
 /// Replace the value of attribute `name` (every occurrence) by `*`.
 fn blank_attr(xml: &str, name: &str) -> String {
@@ -32,13 +33,14 @@ fn blank_attr(xml: &str, name: &str) -> String {
 }
 
 fn normalize(xml: &str) -> String {
-    blank_attr(&blank_attr(xml, "guid"), "generationTool")
+    blank_attr(&blank_attr(&blank_attr(xml, "guid"), "instantiationToken"), "generationTool")
 }
 
-fn generate(path: &Path) -> String {
+/// The FMI 2 (`fmi3` false) or FMI 3 model description of the model file `path`.
+fn generate(path: &Path, fmi3: bool) -> String {
     let text = std::fs::read_to_string(path).expect("model readable");
     let model = load_file(path).unwrap_or_else(|e| panic!("{e}"));
-    write(&model, &text)
+    if fmi3 { fmi3_description::write(&model, &text) } else { fmi2_description::write(&model, &text) }
 }
 
 #[test]
@@ -47,10 +49,11 @@ fn model_descriptions_match_the_golden_files() {
     let mut failures = Vec::new();
     let models = model_files();
     assert!(models.len() >= 8, "example models found: {}", models.len());
-    for path in models {
+    for (path, fmi3) in models.iter().flat_map(|p| [(p, false), (p, true)]) {
         let stem = path.file_stem().expect("file name").to_string_lossy().into_owned();
-        let golden = root().join("modelDescription").join(format!("{stem}.xml"));
-        let actual = generate(&path);
+        let dir = if fmi3 { root().join("modelDescription/fmi3") } else { root().join("modelDescription") };
+        let golden = dir.join(format!("{stem}.xml"));
+        let actual = generate(path, fmi3);
         if bless {
             std::fs::create_dir_all(golden.parent().expect("parent")).expect("create modelDescription/");
             std::fs::write(&golden, &actual).expect("write golden file");
@@ -88,8 +91,10 @@ fn normalization_blanks_only_guid_and_generation_tool() {
 fn the_guid_and_identifier_are_those_of_the_fmi_module() {
     let path = root().join("models/pendulum.xml");
     let text = std::fs::read_to_string(&path).expect("readable");
-    let xml = generate(&path);
+    let xml = generate(&path, false);
     assert!(xml.contains(&format!("  guid=\"{}\"\n", crate::common::guid(&text))));
+    let xml3 = generate(&path, true);
+    assert!(xml3.contains(&format!("  instantiationToken=\"{}\"\n", crate::common::guid(&text))));
     assert!(xml.contains("modelIdentifier=\"pendulum\""));
     assert!(xml.contains(&format!("generationTool=\"mbfmu {}\"", mbfmu::fmi::guid::ENGINE_VERSION)));
 }

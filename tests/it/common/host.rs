@@ -200,9 +200,11 @@ pub fn state(c: Component) -> Option<State> {
     if !(get || set || time_ok || status_ok || logged) {
         return None;
     }
-    let admits = |s: State, f: Func| f.rule().allowed & s.bit() != 0;
+    let admits = |s: State, f: Func| f.rule().allowed2 & s.bit() != 0;
+    // Event Mode is FMI 3's: an FMI 2 instance is never in it.
     let fits: Vec<State> = State::ALL
         .into_iter()
+        .filter(|&s| s != State::EventMode)
         .filter(|&s| {
             admits(s, Func::GetReal) == get
                 && admits(s, Func::SetReal) == set
