@@ -28,6 +28,7 @@ mod expr_derivatives;
 mod flexible;
 mod flexible_dynamics;
 mod flexible_fmu;
+mod fmi3_sequences;
 mod fmi_capi;
 mod fmi_layer;
 mod fmi_sequences;
