@@ -2,8 +2,12 @@
 //! the program tests/it/memory_valgrind.rs runs under valgrind memcheck (issue 12 item 6).
 //! Every status is checked; any failure prints the instance's last messages and exits 1.
 //!
-//! Usage: cargo run --release --example fmu_lifecycle -- MODEL.xml [--steps N]
+//! Usage: cargo run --release --example fmu_lifecycle -- MODEL.xml [--fmi3] [--steps N]
 //! [--thread-stack BYTES] [--leak BYTES]
+//!
+//! `--fmi3`: the same lifecycle through the FMI 3.0 exports (instantiation token, an
+//! initialization mode carrying the experiment, fmi3DoStep with its out-arguments,
+//! directional and adjoint derivatives, FMU states, reset, terminate, free).
 //!
 //! `--thread-stack`: run on a host thread with that stack instead of the main thread (the
 //! exports then run the engine on a stack of their own); `--leak`: leak that many bytes
@@ -182,7 +186,7 @@ struct Options {
 }
 
 fn usage() -> ! {
-    eprintln!("usage: fmu_lifecycle MODEL.xml [--steps N] [--thread-stack BYTES] [--leak BYTES]");
+    eprintln!("usage: fmu_lifecycle MODEL.xml [--fmi3] [--steps N] [--thread-stack BYTES] [--leak BYTES]");
     std::process::exit(2)
 }
 
@@ -211,7 +215,9 @@ fn leak(n: usize) {
 }
 
 fn main() {
-    let args: Vec<String> = std::env::args().skip(1).collect();
+    let mut args: Vec<String> = std::env::args().skip(1).collect();
+    let fmi3 = args.iter().any(|a| a == "--fmi3");
+    args.retain(|a| a != "--fmi3");
     let Some((model_path, rest)) = args.split_first() else { usage() };
     let o = parse_args(rest);
     let t0 = Instant::now();
@@ -222,10 +228,11 @@ fn main() {
         // A host thread with a small stack: the exports switch to a stack of their own.
         Some(bytes) => std::thread::Builder::new()
             .stack_size(bytes)
-            .spawn(move || lifecycle(&plan))
+            .spawn(move || if fmi3 { lifecycle3(&plan) } else { lifecycle(&plan) })
             .expect("a host thread")
             .join()
             .unwrap_or_else(|_| fail(std::ptr::null_mut(), "the host thread panicked")),
+        None if fmi3 => lifecycle3(&plan),
         None => lifecycle(&plan),
     };
     leak(o.leak);
@@ -323,5 +330,125 @@ fn lifecycle(p: &Plan) -> String {
         p.knowns.len(),
         p.unknowns.len(),
         p.steps + 3 + 3 + 1 + 2,
+    )
+}
+
+/// The FMI 3 host's log (its `instanceEnvironment` is not used).
+static LOG3: std::sync::Mutex<Vec<String>> = std::sync::Mutex::new(Vec::new());
+
+unsafe extern "C" fn log3(
+    _env: *mut std::ffi::c_void,
+    _status: i32,
+    _cat: *const std::ffi::c_char,
+    msg: *const std::ffi::c_char,
+) {
+    // SAFETY: a NUL-terminated message, per FMI.
+    let text = unsafe { std::ffi::CStr::from_ptr(msg) }.to_string_lossy().into_owned();
+    LOG3.lock().unwrap_or_else(|e| e.into_inner()).push(text);
+}
+
+/// Require fmi3OK from the call named `what` (FMI 3 lifecycle).
+fn ok3(status: Status, what: &str) {
+    if status != Status::Ok {
+        let log = LOG3.lock().unwrap_or_else(|e| e.into_inner());
+        eprintln!(
+            "fmu_lifecycle: FAILED: {what} returned {status:?}; last messages: {:?}",
+            &log[log.len().saturating_sub(16)..]
+        );
+        std::process::exit(1)
+    }
+}
+
+/// The lifecycle through the FMI 3.0 exports; a summary.
+fn lifecycle3(p: &Plan) -> String {
+    use mbfmu::fmi::exports3_common::*;
+    use mbfmu::fmi::exports3_cs::*;
+    let (top, _) = resources(&p.text, "lifecycle3");
+    let res = CString::new(format!("{}/", top.join("resources").display())).expect("no NUL");
+    let instantiate3 = |token: &str| {
+        let t = CString::new(token).expect("no NUL");
+        // SAFETY: valid strings; no intermediate variables.
+        unsafe {
+            fmi3InstantiateCoSimulation(
+                c"lifecycle3".as_ptr(),
+                t.as_ptr(),
+                res.as_ptr(),
+                0,
+                1,
+                0,
+                0,
+                std::ptr::null(),
+                0,
+                std::ptr::null_mut(),
+                Some(log3),
+                std::ptr::null(),
+            )
+        }
+    };
+    if !instantiate3("{00000000-0000-0000-0000-000000000000}").is_null() {
+        fail(std::ptr::null_mut(), "fmi3InstantiateCoSimulation accepted a wrong token");
+    }
+    let c = instantiate3(&p.guid);
+    if c.is_null() {
+        ok3(Status::Error, "fmi3InstantiateCoSimulation");
+    }
+    let (mut b1, mut b2, mut b3, mut last) = (0u8, 0u8, 0u8, 0.0);
+    let mut calls = 0;
+    // SAFETY: a live instance (until fmi3FreeInstance) and arrays of the stated lengths.
+    unsafe {
+        let init = |c: Component| {
+            ok3(fmi3EnterInitializationMode(c, 1, 1e-6, 0.0, 0, 0.0), "fmi3EnterInitializationMode");
+            for (vr, v) in &p.sets {
+                ok3(fmi3SetFloat64(c, vr, 1, v, 1), "fmi3SetFloat64");
+            }
+            ok3(fmi3ExitInitializationMode(c), "fmi3ExitInitializationMode");
+        };
+        ok3(fmi3SetDebugLogging(c, 1, 0, std::ptr::null()), "fmi3SetDebugLogging");
+        init(c);
+        let mut t = 0.0;
+        for _ in 0..p.steps {
+            ok3(fmi3DoStep(c, t, H, 1, &mut b1, &mut b2, &mut b3, &mut last), "fmi3DoStep");
+            t = last;
+        }
+        let mut v = vec![0.0; p.reals.len()];
+        ok3(fmi3GetFloat64(c, p.reals.as_ptr(), p.reals.len(), v.as_mut_ptr(), v.len()), "fmi3GetFloat64");
+        let mut ms = vec![0; p.integers.len()];
+        ok3(fmi3GetInt32(c, p.integers.as_ptr(), p.integers.len(), ms.as_mut_ptr(), ms.len()), "fmi3GetInt32");
+        let (nk, nu) = (p.knowns.len(), p.unknowns.len());
+        let mut col = vec![0.0; nu];
+        for k in &p.knowns {
+            let st = fmi3GetDirectionalDerivative(c, p.unknowns.as_ptr(), nu, k, 1, &1.0, 1, col.as_mut_ptr(), nu);
+            ok3(st, "fmi3GetDirectionalDerivative");
+            calls += 1;
+        }
+        let mut row = vec![0.0; nk];
+        for u in &p.unknowns {
+            let st = fmi3GetAdjointDerivative(c, u, 1, p.knowns.as_ptr(), nk, &1.0, 1, row.as_mut_ptr(), nk);
+            ok3(st, "fmi3GetAdjointDerivative");
+            calls += 1;
+        }
+        let mut s: FmuStatePtr = std::ptr::null_mut();
+        ok3(fmi3GetFMUState(c, &mut s), "fmi3GetFMUState");
+        let mut size = 0usize;
+        ok3(fmi3SerializedFMUStateSize(c, s, &mut size), "fmi3SerializedFMUStateSize");
+        let mut bytes = vec![0u8; size];
+        ok3(fmi3SerializeFMUState(c, s, bytes.as_mut_ptr(), size), "fmi3SerializeFMUState");
+        let mut back: FmuStatePtr = std::ptr::null_mut();
+        ok3(fmi3DeserializeFMUState(c, bytes.as_ptr(), size, &mut back), "fmi3DeserializeFMUState");
+        ok3(fmi3DoStep(c, t, H, 1, &mut b1, &mut b2, &mut b3, &mut last), "fmi3DoStep");
+        ok3(fmi3SetFMUState(c, back), "fmi3SetFMUState");
+        ok3(fmi3FreeFMUState(c, &mut back), "fmi3FreeFMUState");
+        ok3(fmi3Reset(c), "fmi3Reset");
+        init(c);
+        ok3(fmi3DoStep(c, 0.0, H, 1, &mut b1, &mut b2, &mut b3, &mut last), "fmi3DoStep after fmi3Reset");
+        ok3(fmi3Terminate(c), "fmi3Terminate");
+        // `s` is left for fmi3FreeInstance to free.
+        fmi3FreeInstance(c);
+    }
+    std::fs::remove_dir_all(&top).unwrap_or_else(|e| panic!("{}: {e}", top.display()));
+    format!(
+        "FMI 3: {} knowns x {} unknowns, {calls} derivative calls, 1 FMU state left to fmi3FreeInstance",
+        p.knowns.len(),
+        p.unknowns.len()
     )
 }

@@ -170,6 +170,13 @@ fn cart_pendulum_pid_lifecycle_on_a_64_kib_host_thread_has_no_memory_errors_and_
 }
 
 #[test]
+fn fmi3_cart_pendulum_pid_lifecycle_on_a_64_kib_host_thread_has_no_memory_errors_and_no_leak() {
+    // The FMI 3 exports (instantiation, steps, directional and adjoint derivatives, FMU
+    // states with one left for fmi3FreeInstance, reset, terminate, free).
+    clean("models/cart_pendulum_pid.xml", &["--fmi3", "--thread-stack", "65536"]);
+}
+
+#[test]
 fn a_deliberate_leak_fails_the_memcheck_run() {
     if have_valgrind("a_deliberate_leak_fails_the_memcheck_run") {
         let run = memcheck("pendulum.xml", &["--leak", "4096"]);
