@@ -1,5 +1,5 @@
-"""One FMU instance driven through time: open (zip or directory), instantiate with a
-logger whose messages go into errors, initialize with start values and fmpy-style input
+"""One FMU instance (FMI 2.0; FMI 3.0 Co-Simulation) driven through time: open (zip or
+directory), instantiate with a logger whose messages go into errors, initialize with start values and fmpy-style input
 signals, advance to a time (Co-Simulation: doStep; Model Exchange: CVode with events),
 and read values and directional derivatives at the current point.
 
@@ -27,6 +27,7 @@ from fmpy.fmi2 import (
     fmi2CallbackFunctions,
     fmi2CallbackLoggerTYPE,
 )
+from fmpy.fmi3 import FMU3Slave
 
 from .errors import ArgumentError, FMUCallError, FMUNotFoundError, MbfmuError
 
@@ -117,6 +118,8 @@ class Opened:
                 self._tmp = extract(str(p))
                 self.unzipdir = self._tmp
             self.md = read_model_description(self.unzipdir, validate=False)
+            if is_fmi3(self.md):
+                fmi3_flags(self.md, Path(self.unzipdir) / "modelDescription.xml")
         except MbfmuError:
             raise
         except Exception as e:
@@ -133,6 +136,24 @@ class Opened:
 
     def __exit__(self, *exc):
         self.close()
+
+
+def is_fmi3(md) -> bool:
+    """Whether `md` describes an FMI 3.0 FMU."""
+    return str(md.fmiVersion).startswith("3.")
+
+
+def fmi3_flags(md, xml: Path) -> None:
+    """fmpy 0.3.x reads FMI 3's `providesDirectionalDerivatives` under its FMI 2 name,
+    `providesDirectionalDerivative`, so it reports False for every FMI 3 FMU: take the
+    flag from the file."""
+    import xml.etree.ElementTree as ET
+
+    root = ET.parse(xml).getroot()
+    for tag, info in (("CoSimulation", md.coSimulation), ("ModelExchange", md.modelExchange)):
+        node = root.find(tag)
+        if info is not None and node is not None:
+            info.providesDirectionalDerivative = node.get("providesDirectionalDerivatives") == "true"
 
 
 def choose_interface(md, interface: str | None = None) -> str:
@@ -198,7 +219,12 @@ class Instance:
         self.name = f"mbfmu{next(_NAMES)}"
         with _LOG_LOCK:
             _LOGS[self.name] = []
-        cls = FMU2Slave if interface == "CoSimulation" else FMU2Model
+        self.fmi3 = is_fmi3(md)
+        if self.fmi3 and interface != "CoSimulation":
+            raise ArgumentError(
+                f"FMU '{md.modelName}': FMI 3.0 Model Exchange is not supported (FMI 3.0: Co-Simulation only)"
+            )
+        cls = FMU3Slave if self.fmi3 else FMU2Slave if interface == "CoSimulation" else FMU2Model
         info = md.coSimulation if interface == "CoSimulation" else md.modelExchange
         self.time = math.nan
         self.fmu = self._call(
@@ -215,8 +241,15 @@ class Instance:
         self._solver = None
         self._next_event = math.inf
         self._alive = False
-        self._call("fmi2Instantiate", lambda: self.fmu.instantiate(callbacks=self._callbacks, loggingOn=False))
+        if self.fmi3:
+            self._call("fmi3InstantiateCoSimulation", lambda: self.fmu.instantiate(logMessage=self._log3))
+        else:
+            self._call("fmi2Instantiate", lambda: self.fmu.instantiate(callbacks=self._callbacks, loggingOn=False))
         self._alive = True
+
+    def _log3(self, env, status, category, message) -> None:
+        """The FMI 3 logMessage callback (it names no instance: one closure per instance)."""
+        _dispatch(env, self.name.encode(), status, category, message)
 
     @classmethod
     def attach(cls, fmu, md, time: float) -> Instance:
@@ -224,6 +257,7 @@ class Instance:
         self = cls.__new__(cls)
         self.md = md
         self.interface = "ModelExchange" if isinstance(fmu, FMU2Model) else "CoSimulation"
+        self.fmi3 = isinstance(fmu, FMU3Slave)
         self.name = getattr(fmu, "instanceName", "host instance")
         self.fmu = fmu
         self.time = self.start_time = float(time)
@@ -272,15 +306,26 @@ class Instance:
             sv[MAX_STEPS_VARIABLE] = BATCH_MAX_STEPS
         self.time = start_time
         self.start_time = start_time
-        if cs:
+        if self.fmi3:
+            sv = self._call(
+                "setting start values", lambda: apply_start_values(fmu, self.md, sv, settable_in_instantiated)
+            )
             self._call(
-                "fmi2SetupExperiment",
-                lambda: fmu.setupExperiment(tolerance=self.tolerance, startTime=start_time, stopTime=stop_time),
+                "fmi3EnterInitializationMode",
+                lambda: fmu.enterInitializationMode(tolerance=self.tolerance, startTime=start_time, stopTime=stop_time),
             )
         else:
-            self._call("fmi2SetupExperiment", lambda: fmu.setupExperiment(startTime=start_time, stopTime=stop_time))
-        sv = self._call("setting start values", lambda: apply_start_values(fmu, self.md, sv, settable_in_instantiated))
-        self._call("fmi2EnterInitializationMode", fmu.enterInitializationMode)
+            if cs:
+                self._call(
+                    "fmi2SetupExperiment",
+                    lambda: fmu.setupExperiment(tolerance=self.tolerance, startTime=start_time, stopTime=stop_time),
+                )
+            else:
+                self._call("fmi2SetupExperiment", lambda: fmu.setupExperiment(startTime=start_time, stopTime=stop_time))
+            sv = self._call(
+                "setting start values", lambda: apply_start_values(fmu, self.md, sv, settable_in_instantiated)
+            )
+            self._call("fmi2EnterInitializationMode", fmu.enterInitializationMode)
         sv = self._call(
             "setting start values", lambda: apply_start_values(fmu, self.md, sv, settable_in_initialization)
         )
@@ -289,7 +334,7 @@ class Instance:
         # Slopes are set here, not by fmpy's Input(set_input_derivatives=True), whose buffer
         # holds exactly 9 inputs (fmpy 0.3.x).
         self._slopes = None
-        if cs and bool(self.md.coSimulation.canInterpolateInputs) and inputs is not None:
+        if cs and not self.fmi3 and bool(self.md.coSimulation.canInterpolateInputs) and inputs is not None:
             self._slopes = _Slopes(self.md, inputs)
         self._input = self._call("reading inputs", lambda: Input(fmu, self.md, inputs))
         self._apply_inputs()
@@ -409,14 +454,23 @@ class Instance:
         vrs = list(vrs)
         if not vrs:
             return np.zeros(0)
+        if self.fmi3:
+            return np.array(self._call("fmi3GetFloat64", lambda: self.fmu.getFloat64(vrs)), dtype=float)
         return np.array(self._call("fmi2GetReal", lambda: self.fmu.getReal(vrs)), dtype=float)
 
     def set(self, vrs, values) -> None:
         vrs = list(vrs)
-        if vrs:
+        if vrs and self.fmi3:
+            self._call("fmi3SetFloat64", lambda: self.fmu.setFloat64(vrs, [float(v) for v in values]))
+        elif vrs:
             self._call("fmi2SetReal", lambda: self.fmu.setReal(vrs, [float(v) for v in values]))
 
     def directional_derivative(self, unknowns, knowns, seeds) -> list[float]:
+        if self.fmi3:
+            return self._call(
+                "fmi3GetDirectionalDerivative",
+                lambda: self.fmu.getDirectionalDerivative(list(unknowns), list(knowns), list(seeds)),
+            )
         return self._call(
             "fmi2GetDirectionalDerivative",
             lambda: self.fmu.getDirectionalDerivative(list(unknowns), list(knowns), list(seeds)),

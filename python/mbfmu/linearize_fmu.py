@@ -10,11 +10,13 @@ from __future__ import annotations
 import math
 import warnings
 from collections.abc import Iterable
+from pathlib import Path
 
 import numpy as np
+from fmpy.fmi3 import FMU3Slave
 
 from .errors import ArgumentError, MbfmuError, NotLinearizableError
-from .instance import Instance, Opened, check_start_values, choose_interface
+from .instance import Instance, Opened, check_start_values, choose_interface, fmi3_flags, is_fmi3
 from .jacobian import central_differences, directional
 from .linearization import DIFFERENCES, DIRECTIONAL, Linearization
 from .structure import Structure, read_structure
@@ -183,8 +185,11 @@ def linearize_opened(
     return out  # type: ignore[return-value]
 
 
-def _live_time(fmu) -> float | None:
+def _live_time(fmu, md) -> float | None:
     try:
+        if isinstance(fmu, FMU3Slave):  # FMI 3: the independent variable
+            vr = next(v.valueReference for v in md.modelVariables if v.causality == "independent")
+            return float(fmu.getFloat64([vr])[0])
         return float(fmu.getRealStatus(2))  # fmi2LastSuccessfulTime
     except Exception:
         return None
@@ -196,10 +201,12 @@ def linearize_instance(fmu, at=None, step=None, use_dependencies=True) -> list[L
     from fmpy import read_model_description
 
     md = read_model_description(fmu.unzipDirectory, validate=False)
+    if is_fmi3(md):
+        fmi3_flags(md, Path(fmu.unzipDirectory) / "modelDescription.xml")
     inst = Instance.attach(fmu, md, math.nan)
     st = read_structure(md, inst.interface)
     _warn_differences(st)
-    now = _live_time(fmu) if inst.interface == "CoSimulation" else None
+    now = _live_time(fmu, md) if inst.interface == "CoSimulation" else None
     if at is None:
         if now is not None:
             inst.time = inst.start_time = now
@@ -243,7 +250,8 @@ def linearize(
     """Simulate `fmu` once through the times `at` and return its linearization at each.
 
     fmu: path of an FMI 2.0 FMU (zip or extracted directory), Co-Simulation or Model
-        Exchange; or an instantiated fmpy FMU2Slave/FMU2Model at a communication point
+        Exchange, or of an FMI 3.0 Co-Simulation FMU; or an instantiated fmpy
+        FMU2Slave/FMU2Model/FMU3Slave at a communication point
         (then only `at`, `step`, `use_dependencies` apply; at=None linearizes where it stands).
     at: a time or times (any order; results come back in that order); None = start time.
     start_values: {name: value} for parameters and start values, as fmpy.simulate_fmu.
@@ -260,7 +268,7 @@ def linearize(
     """
     from fmpy.fmi2 import _FMU2
 
-    if isinstance(fmu, _FMU2):
+    if isinstance(fmu, _FMU2 | FMU3Slave):
         if start_values or inputs is not None or tolerance is not None:
             raise ArgumentError(
                 "start_values, inputs and tolerance cannot be given for an instance that is already "

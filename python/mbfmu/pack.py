@@ -66,7 +66,7 @@ def run_cli(args: list[str], command: str) -> subprocess.CompletedProcess:
     return r
 
 
-def pack(model, out=None, out_dir=None, start_values=None) -> Path:
+def pack(model, out=None, out_dir=None, start_values=None, fmi: int = 2) -> Path:
     """Pack `model` (an mbfmu model file) into the FMU `out` (default: the model's name
     with .fmu beside it); `out_dir` also writes the unzipped FMU there. Returns `out`.
     `start_values` (a dict parameter or state name -> float) replaces the file's values as
@@ -75,12 +75,15 @@ def pack(model, out=None, out_dir=None, start_values=None) -> Path:
     modelDescription's `start` and an instance's defaults). A model error, an unknown
     name (with a "did you mean" when one is close) or a value the model rejects is raised
     as ArgumentError with the tool's message; what the packed FMU lacks (the tool's
-    warnings) is issued as a PackWarning."""
+    warnings) is issued as a PackWarning. `fmi=3` packs an FMI 3.0 Co-Simulation FMU
+    (with directional and adjoint derivatives) instead of FMI 2.0."""
     model = Path(model)
     if not model.is_file():
         raise FMUNotFoundError(f"model file '{model}' does not exist")
+    if fmi not in (2, 3):
+        raise ArgumentError(f"fmi={fmi!r}: expected 2 or 3")
     out = Path(out) if out is not None else model.with_suffix(".fmu")
-    args = [str(cli()), "pack", str(model), "-o", str(out)]
+    args = [str(cli()), "pack", str(model), "-o", str(out), "--fmi", str(fmi)]
     if out_dir is not None:
         args += ["--out-dir", str(out_dir)]
     r = run_cli([*args, *set_args(start_values)], "pack")
