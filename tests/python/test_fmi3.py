@@ -197,3 +197,21 @@ def test_a_step_cut_by_max_steps_is_discarded_at_the_time_reached(fmus):
     assert any("fmi3DoStep" in m and "stopped" in m for m in messages), messages
     f.terminate()
     f.freeInstance()
+
+
+def test_derivatives_in_initialization_mode_are_those_at_the_start(fmus):
+    # FMI 3 allows both derivative functions in Initialization Mode: the engine is built
+    # there with the values set, so they equal those right after initialization (t = 0).
+    fmu2, fmu3 = fmus("cart_pendulum_pid")
+    md, f = instance(fmu3, FMU3Slave)
+    knowns, unknowns = knowns_unknowns(md)
+    f.enterInitializationMode(startTime=0.0)
+    seed = list(np.linspace(0.5, -1.0, len(knowns)))
+    weights = list(np.linspace(-1.0, 2.0, len(unknowns)))
+    during = f.getDirectionalDerivative(unknowns, knowns, seed)
+    during_adj = f.getAdjointDerivative(unknowns, knowns, weights, nSensitivity=len(knowns))
+    f.exitInitializationMode()
+    assert f.getDirectionalDerivative(unknowns, knowns, seed) == during
+    assert f.getAdjointDerivative(unknowns, knowns, weights, nSensitivity=len(knowns)) == during_adj
+    f.terminate()
+    f.freeInstance()
