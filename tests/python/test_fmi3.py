@@ -117,7 +117,7 @@ def test_directional_and_adjoint_derivatives_equal_the_fmi2_matrices(fmus, name)
         f.freeInstance()
 
 
-@pytest.mark.parametrize("name", ["double_pendulum", "cart_pendulum_pid", "benchmark_bicycle"])
+@pytest.mark.parametrize("name", EXAMPLES)
 def test_simulate_fmu_gives_the_fmi2_trajectory(fmus, name):
     fmu2, fmu3 = fmus(name)
     r2 = simulate_fmu(str(fmu2), stop_time=0.5, output_interval=0.01)
