@@ -239,76 +239,40 @@ fn scalars(nvr: size_t, nvalues: size_t) -> Result<(), String> {
     }
 }
 
-/// fmi3GetFloat64: as fmi2GetReal (and `time`).
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3GetFloat64(
-    c: Component,
-    vr: *const ValueReference,
-    nvr: size_t,
-    values: *mut f64,
-    nValues: size_t,
-) -> Status {
-    guarded(c, Func::GetReal, |inst| {
-        scalars(nvr, nValues)?;
-        // SAFETY: nvr elements each, per FMI.
-        let (vr, values) = unsafe { (slice(vr, nvr, "valueReferences")?, slice_mut(values, nvr, "values")?) };
-        inst.get_reals(vr, values)?;
-        Ok(Status::Ok)
-    })
+/// Getters and setters of the FMU's variable types: `(instance, valueReferences,
+/// nValueReferences, values, nValues)`, every variable a scalar; the body is the
+/// instance's FMI 2 one.
+macro_rules! values {
+    ($($(#[$doc:meta])* $name:ident, $func:expr, $ptr:ty, $array:ident, $method:ident;)*) => {$(
+        $(#[$doc])*
+        #[unsafe(no_mangle)]
+        pub unsafe extern "C" fn $name(
+            c: Component,
+            vr: *const ValueReference,
+            nvr: size_t,
+            values: $ptr,
+            nValues: size_t,
+        ) -> Status {
+            guarded(c, $func, |inst| {
+                scalars(nvr, nValues)?;
+                // SAFETY: nvr elements each, per FMI.
+                let (vr, values) = unsafe { (slice(vr, nvr, "valueReferences")?, $array(values, nvr, "values")?) };
+                inst.$method(vr, values)?;
+                Ok(Status::Ok)
+            })
+        }
+    )*};
 }
 
-/// fmi3SetFloat64: as fmi2SetReal.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3SetFloat64(
-    c: Component,
-    vr: *const ValueReference,
-    nvr: size_t,
-    values: *const f64,
-    nValues: size_t,
-) -> Status {
-    guarded(c, Func::SetReal, |inst| {
-        scalars(nvr, nValues)?;
-        // SAFETY: nvr elements each, per FMI.
-        let (vr, values) = unsafe { (slice(vr, nvr, "valueReferences")?, slice(values, nvr, "values")?) };
-        inst.set_reals(vr, values)?;
-        Ok(Status::Ok)
-    })
-}
-
-/// fmi3GetInt32: `solver.maxSteps`.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3GetInt32(
-    c: Component,
-    vr: *const ValueReference,
-    nvr: size_t,
-    values: *mut i32,
-    nValues: size_t,
-) -> Status {
-    guarded(c, Func::GetInteger, |inst| {
-        scalars(nvr, nValues)?;
-        // SAFETY: nvr elements each, per FMI.
-        let (vr, values) = unsafe { (slice(vr, nvr, "valueReferences")?, slice_mut(values, nvr, "values")?) };
-        inst.get_integers(vr, values)?;
-        Ok(Status::Ok)
-    })
-}
-
-/// fmi3SetInt32: `solver.maxSteps` (tunable), at least 1.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3SetInt32(
-    c: Component,
-    vr: *const ValueReference,
-    nvr: size_t,
-    values: *const i32,
-    nValues: size_t,
-) -> Status {
-    guarded(c, Func::SetInteger, |inst| {
-        scalars(nvr, nValues)?;
-        // SAFETY: nvr elements each, per FMI.
-        let (vr, values) = unsafe { (slice(vr, nvr, "valueReferences")?, slice(values, nvr, "values")?) };
-        inst.set_integers(vr, values)?;
-        Ok(Status::Ok)
-    })
+values! {
+    /// fmi3GetFloat64: as fmi2GetReal (and `time`).
+    fmi3GetFloat64, Func::GetReal, *mut f64, slice_mut, get_reals;
+    /// fmi3SetFloat64: as fmi2SetReal.
+    fmi3SetFloat64, Func::SetReal, *const f64, slice, set_reals;
+    /// fmi3GetInt32: `solver.maxSteps`.
+    fmi3GetInt32, Func::GetInteger, *mut i32, slice_mut, get_integers;
+    /// fmi3SetInt32: `solver.maxSteps` (tunable), at least 1.
+    fmi3SetInt32, Func::SetInteger, *const i32, slice, set_integers;
 }
 
 /// fmi3GetFMUState: as fmi2GetFMUstate.

@@ -8,6 +8,7 @@
 
 use crate::common::host::resources_of;
 use crate::common::{guid_of, model_files};
+use crate::fmi_sequences::Rng;
 use mbfmu::fmi::exports3_common::*;
 use mbfmu::fmi::exports3_cs::*;
 use mbfmu::fmi::exports3_other::*;
@@ -23,31 +24,6 @@ unsafe extern "C" fn log_message(env: *mut c_void, _status: c_int, _category: *c
     // SAFETY: `env` is the `Log` the test passed; `message` a NUL-terminated string.
     let (log, text) = unsafe { (&*(env as *const Log), CStr::from_ptr(message).to_string_lossy().into_owned()) };
     log.lock().unwrap().push(text);
-}
-
-/// splitmix64.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n as u64) as usize
-    }
-    fn real(&mut self) -> f64 {
-        match self.below(10) {
-            0 => f64::NAN,
-            1 => f64::INFINITY,
-            2 => [1e30, -1e30, 1e-310][self.below(3)],
-            3 => 0.0,
-            _ => (self.next() >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0,
-        }
-    }
 }
 
 fn allowed(s: Status) -> bool {
