@@ -306,25 +306,20 @@ class Instance:
             sv[MAX_STEPS_VARIABLE] = BATCH_MAX_STEPS
         self.time = start_time
         self.start_time = start_time
-        if self.fmi3:
-            sv = self._call(
-                "setting start values", lambda: apply_start_values(fmu, self.md, sv, settable_in_instantiated)
+        # The experiment: FMI 2 sets it first; FMI 3 passes it on entering initialization.
+        if not self.fmi3:
+            tol = self.tolerance if cs else None
+            self._call(
+                "fmi2SetupExperiment",
+                lambda: fmu.setupExperiment(tolerance=tol, startTime=start_time, stopTime=stop_time),
             )
+        sv = self._call("setting start values", lambda: apply_start_values(fmu, self.md, sv, settable_in_instantiated))
+        if self.fmi3:
             self._call(
                 "fmi3EnterInitializationMode",
                 lambda: fmu.enterInitializationMode(tolerance=self.tolerance, startTime=start_time, stopTime=stop_time),
             )
         else:
-            if cs:
-                self._call(
-                    "fmi2SetupExperiment",
-                    lambda: fmu.setupExperiment(tolerance=self.tolerance, startTime=start_time, stopTime=stop_time),
-                )
-            else:
-                self._call("fmi2SetupExperiment", lambda: fmu.setupExperiment(startTime=start_time, stopTime=stop_time))
-            sv = self._call(
-                "setting start values", lambda: apply_start_values(fmu, self.md, sv, settable_in_instantiated)
-            )
             self._call("fmi2EnterInitializationMode", fmu.enterInitializationMode)
         sv = self._call(
             "setting start values", lambda: apply_start_values(fmu, self.md, sv, settable_in_initialization)

@@ -231,7 +231,7 @@ pub unsafe extern "C" fn fmi3Reset(c: Component) -> Status {
 }
 
 /// Err unless `nValues` equals `nValueReferences` (every variable is a scalar).
-fn scalars(nvr: size_t, nvalues: size_t) -> Result<(), String> {
+pub(super) fn scalars(nvr: size_t, nvalues: size_t) -> Result<(), String> {
     if nvr == nvalues {
         Ok(())
     } else {

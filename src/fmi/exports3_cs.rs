@@ -5,7 +5,7 @@
 #![allow(clippy::missing_safety_doc)]
 #![allow(non_snake_case)]
 
-use super::exports3_common::Bool3;
+use super::exports3_common::{Bool3, scalars};
 use super::guard::{guarded, put, slice, slice_mut};
 use super::instance::Step;
 use super::state_machine::{Func, State};
@@ -70,9 +70,7 @@ pub unsafe extern "C" fn fmi3GetOutputDerivatives(
     nValues: size_t,
 ) -> Status {
     guarded(c, Func::GetRealOutputDerivatives, |inst| {
-        if nValues != nvr {
-            return Err(format!("nValues = {nValues} but the {nvr} outputs are scalars"));
-        }
+        scalars(nvr, nValues)?;
         // SAFETY: nvr elements each, per FMI.
         let (vr, orders, values) = unsafe {
             (slice(vr, nvr, "valueReferences")?, slice(orders, nvr, "orders")?, slice_mut(values, nvr, "values")?)

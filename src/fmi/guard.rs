@@ -68,9 +68,7 @@ pub fn guarded_as(
     let standard = inst.standard;
     let fname = name.unwrap_or_else(|| func.name_in(standard));
     let run = catch_unwind(AssertUnwindSafe(|| {
-        if func == Func::Unsupported {
-            // No state forbids the call; the body says why it cannot be done.
-        } else if let Err(msg) = check(inst.state, func, standard) {
+        if let Err(msg) = check(inst.state, func, standard, fname) {
             inst.log(Status::Error, &msg);
             return Status::Error;
         }

@@ -450,41 +450,20 @@ impl Instance {
         dv: &[f64],
         out: &mut [f64],
     ) -> Result<(), String> {
-        // Columns of A/C: S, W, X (the variables' `known`); then inputs (B/D). Rows: Ṡ, Ẇ, Ẋ
-        // (`unknown`), then outputs.
-        let ns = self.vars.iter().filter(|v| v.known.is_some()).count();
-        let col = |v: &Variable| match v.target {
-            Target::Input(i) => Some(ns + i),
-            _ => v.known,
-        };
-        let row = |v: &Variable| match v.target {
-            Target::Output(o) => Some((true, o)),
-            _ => v.unknown.map(|r| (false, r)),
-        };
-        let mut kc = Vec::with_capacity(knowns.len());
-        for &vr in knowns {
-            let v = self.var(vr)?;
-            kc.push(col(v).ok_or_else(|| format!("known '{}' (vr {vr}) is neither a state nor an input", v.name))?);
-        }
-        let mut ur = Vec::with_capacity(unknowns.len());
-        for &vr in unknowns {
-            let v = self.var(vr)?;
-            ur.push(row(v).ok_or_else(|| {
-                format!("unknown '{}' (vr {vr}) is neither a state derivative nor an output", v.name)
-            })?);
-        }
+        let (rows, cols) = self.positions(unknowns, knowns)?;
+        let ns = self.state_count();
         if let Some(v) = dv.iter().find(|v| !v.is_finite()) {
             return Err(format!("seed value {v} is not finite"));
         }
         let lin = self.linearization()?;
-        for (o, &(is_output, r)) in out.iter_mut().zip(&ur) {
+        for (o, &r) in out.iter_mut().zip(&rows) {
             let mut acc = 0.0;
-            for (&c, &d) in kc.iter().zip(dv) {
-                acc += d * match (is_output, c < ns) {
-                    (false, true) => lin.a[(r, c)],
-                    (false, false) => lin.b[(r, c - ns)],
-                    (true, true) => lin.c[(r, c)],
-                    (true, false) => lin.d[(r, c - ns)],
+            for (&c, &d) in cols.iter().zip(dv) {
+                acc += d * match (r < ns, c < ns) {
+                    (true, true) => lin.a[(r, c)],
+                    (true, false) => lin.b[(r, c - ns)],
+                    (false, true) => lin.c[(r - ns, c)],
+                    (false, false) => lin.d[(r - ns, c - ns)],
                 };
             }
             *o = acc;
@@ -492,10 +471,15 @@ impl Instance {
         self.all_finite("the directional derivative", unknowns, out)
     }
 
-    /// The columns (states S, W, X, then inputs) of the knowns `knowns` and the rows
-    /// (state derivatives, then outputs) of the unknowns `unknowns` of [A B; C D].
+    /// The number of linearization states (columns of A).
+    fn state_count(&self) -> usize {
+        self.vars.iter().filter(|v| v.known.is_some()).count()
+    }
+
+    /// The rows (state derivatives, then outputs) of the unknowns `unknowns` and the
+    /// columns (states S, W, X, then inputs) of the knowns `knowns` of [A B; C D].
     fn positions(&self, unknowns: &[u32], knowns: &[u32]) -> Result<(Vec<usize>, Vec<usize>), String> {
-        let ns = self.vars.iter().filter(|v| v.known.is_some()).count();
+        let ns = self.state_count();
         let mut cols = Vec::with_capacity(knowns.len());
         for &vr in knowns {
             let v = self.var(vr)?;

@@ -138,13 +138,13 @@ impl Sink {
 
     /// Hand `msg` to the host's logger (nothing when it gave none).
     pub fn emit(&self, status: Status, msg: &str) {
+        let Some(callback) = self.callback else { return };
         let text = c_text(msg);
-        match self.callback {
-            None => {}
+        match callback {
             // SAFETY: `cb` is the host's fmi2CallbackLogger; every pointer passed is a valid
             // NUL-terminated string living across the call, and the format "%s" consumes
             // exactly the one string argument given.
-            Some(Callback::Fmi2(cb)) => unsafe {
+            Callback::Fmi2(cb) => unsafe {
                 cb(
                     self.env,
                     self.name.as_ptr(),
@@ -156,7 +156,7 @@ impl Sink {
             },
             // SAFETY: `cb` is the host's fmi3LogMessageCallback; the strings are valid and
             // NUL-terminated across the call.
-            Some(Callback::Fmi3(cb)) => unsafe {
+            Callback::Fmi3(cb) => unsafe {
                 cb(self.env, status as libc::c_int, category(status).as_ptr(), text.as_ptr())
             },
         }

@@ -4,6 +4,8 @@
 //! version (where the two differ, the table says so), and one guard every export runs
 //! first.
 
+use super::variables::Standard;
+
 /// A state of a Co-Simulation instance; each is one bit so a set of states is a mask.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum State {
@@ -271,22 +273,17 @@ impl Func {
     }
 }
 
-/// The guard: `Err("fmiXY: not allowed in state Z")` when `func` is illegal in `state` for
-/// an instance of FMI version `standard`.
-pub fn check(state: State, func: Func, standard: Standard) -> Result<(), String> {
+/// The guard: `Err("<name>: not allowed in state Z")` when `func` is illegal in `state` for
+/// an instance of FMI version `standard`; `name` is the C name the call came in by (the
+/// table's, or that of an FMI 3 function sharing [`Func::Unsupported`]'s row).
+pub fn check(state: State, func: Func, standard: Standard, name: &str) -> Result<(), String> {
     let r = func.rule();
     let allowed = match standard {
         Standard::Fmi2 => r.allowed2,
         Standard::Fmi3 => r.allowed3,
     };
-    if allowed & state.bit() != 0 {
-        Ok(())
-    } else {
-        Err(format!("{}: not allowed in state {state:?}", func.name_in(standard)))
-    }
+    if allowed & state.bit() != 0 { Ok(()) } else { Err(format!("{name}: not allowed in state {state:?}")) }
 }
-
-use super::variables::Standard;
 
 #[cfg(test)]
 mod tests {
@@ -301,6 +298,7 @@ mod tests {
 
     #[test]
     fn do_step_is_legal_only_after_initialization() {
+        let check = |s, f: Func, standard| check(s, f, standard, f.name_in(standard));
         assert!(check(State::StepComplete, Func::DoStep, Standard::Fmi2).is_ok());
         let e = check(State::Instantiated, Func::DoStep, Standard::Fmi2).unwrap_err();
         assert_eq!(e, "fmi2DoStep: not allowed in state Instantiated");

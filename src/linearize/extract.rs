@@ -25,10 +25,7 @@ pub(super) fn extract(
     let d = Mat::from_fn(no, ni, |o, v| sol[ns + v][ns + o] + sens.direct(o, v));
     for o in 0..no {
         if (0..ns).any(|col| !c[(o, col)].is_finite()) || (0..ni).any(|v| !d[(o, v)].is_finite()) {
-            return Err(EngineError::Numeric(format!(
-                "output '{}' has no finite derivative here (e.g. |v| at v = 0, or the load of a user constraint)",
-                sys.output_names[o]
-            )));
+            return Err(no_finite_derivative(&sys.output_names[o]));
         }
     }
     let mut x = values;
@@ -39,6 +36,13 @@ pub(super) fn extract(
     states.extend(sys.user.iter().take(p.eq.nx).map(|u| u.name.clone()));
     let (inputs, outputs) = (sys.input_names.clone(), sys.output_names.clone());
     Ok(Linearization { time: p.t, states, inputs, outputs, a, b, c, d, x, solves })
+}
+
+/// The error of an output whose derivative is not finite at the operating point.
+pub(super) fn no_finite_derivative(output: &str) -> EngineError {
+    EngineError::Numeric(format!(
+        "output '{output}' has no finite derivative here (e.g. |v| at v = 0, or the load of a user constraint)"
+    ))
 }
 
 /// Where W_j = Ṡ_k (always without non-holonomic constraints), row k of A and B is

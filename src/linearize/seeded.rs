@@ -10,6 +10,7 @@
 use super::assemble::{Assembled, assemble};
 use super::augmented::{at_point, singular};
 use super::eq34::Eq34;
+use super::extract::no_finite_derivative;
 use super::operating_point::OperatingPoint;
 use super::rhs::RightHandSides;
 use super::select::Selection;
@@ -78,18 +79,13 @@ impl Seeded {
     /// One solve of Eq. 34 (or its transpose) with the right-hand side `fill` writes into
     /// a zeroed vector; Ok(None) when it writes nothing (the solution is zero), Err when
     /// the solution is not finite.
-    fn solve(
-        lu: &SparseLu,
-        eq: &Eq34,
-        transpose: bool,
-        fill: impl Fn(&mut [f64]) + Sync,
-    ) -> Result<Option<Vec<f64>>, ()> {
+    fn solve(lu: &SparseLu, eq: &Eq34, transpose: bool, fill: impl Fn(&mut [f64])) -> Result<Option<Vec<f64>>, ()> {
         let mut b = vec![0.0; eq.dim()];
         fill(&mut b);
         if b.iter().all(|v| *v == 0.0) {
             return Ok(None);
         }
-        let x = lu.solve_columns(1, 1, transpose, |_, col| fill(col), |_, x| x.to_vec());
+        let x = lu.solve_columns(1, 1, transpose, |_, col| col.copy_from_slice(&b), |_, x| x.to_vec());
         x.and_then(|mut v| v.pop()).map(Some).ok_or(())
     }
 
@@ -147,10 +143,7 @@ impl Seeded {
             let nonfinite =
                 (0..self.outputs.len()).find(|&o| seed[ns + o] != 0.0 && !self.sens.row_finite(ns + o, kinematic));
             if let Some(o) = nonfinite {
-                return Err(EngineError::Numeric(format!(
-                    "output '{}' has no finite derivative here (e.g. |v| at v = 0, or the load of a user constraint)",
-                    self.outputs[o]
-                )));
+                return Err(no_finite_derivative(&self.outputs[o]));
             }
             let sens = &self.sens;
             let fill = |g: &mut [f64]| {

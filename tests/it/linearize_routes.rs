@@ -5,10 +5,10 @@
 //! solves. (Each route is checked against independent references through the other
 //! linearization tests: these run the automatic route.)
 
-use crate::common::{model, model_files};
+use crate::common::{model, moving_examples};
 use mbfmu::dae::{SimOptions, Simulator};
 use mbfmu::linearize::{Linearization, Route, linearize_with, select_states};
-use mbfmu::model::parse::{load_file, load_str};
+use mbfmu::model::parse::load_str;
 
 /// Largest |x − y| over the four matrices, relative to 1 + the largest |entry|.
 fn difference(a: &Linearization, b: &Linearization) -> f64 {
@@ -40,12 +40,7 @@ fn both(sim: &mut Simulator) -> f64 {
 fn rows_and_columns_give_the_same_linearization() {
     // 1e-10: the two solve different triangular systems with one LU; their round-off
     // is cond(K)·ε, with K's condition numbers here below 1e5.
-    for path in &model_files() {
-        let model = load_file(path).unwrap();
-        let t0 = model.experiment.start.unwrap_or(0.0);
-        let mut sim =
-            Simulator::new(&model, SimOptions { tol: 1e-10, max_step: None, ..Default::default() }, t0).unwrap();
-        sim.advance(t0 + 0.05).unwrap();
+    for (path, mut sim) in moving_examples() {
         let d = both(&mut sim);
         assert!(d < 1e-10, "{}: routes differ by {d:e}", path.display());
     }

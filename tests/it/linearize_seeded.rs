@@ -5,11 +5,10 @@
 //! products; each call costs at most two solves. (The full linearization is checked
 //! against independent references by the other linearization tests.)
 
-use crate::common::model_files;
+use crate::common::moving_examples;
 use faer::Mat;
-use mbfmu::dae::{SimOptions, Simulator};
+use mbfmu::dae::Simulator;
 use mbfmu::linearize::{Linearization, Seeded, linearize, select_states};
-use mbfmu::model::parse::load_file;
 
 /// [A B; C D] as one dense matrix.
 fn whole(l: &Linearization) -> Mat<f64> {
@@ -78,12 +77,7 @@ fn compare(sim: &mut Simulator) -> (f64, usize) {
 fn seeded_products_equal_the_full_linearization() {
     // 1e-10 as between the column and row routes (linearize_routes.rs): the same LU,
     // other right-hand sides, round-off cond(K)·ε with cond(K) < 1e5 here.
-    for path in &model_files() {
-        let model = load_file(path).unwrap();
-        let t0 = model.experiment.start.unwrap_or(0.0);
-        let mut sim =
-            Simulator::new(&model, SimOptions { tol: 1e-10, max_step: None, ..Default::default() }, t0).unwrap();
-        sim.advance(t0 + 0.05).unwrap();
+    for (path, mut sim) in moving_examples() {
         let (d, most) = compare(&mut sim);
         assert!(d < 1e-10, "{}: seeded products differ by {d:e}", path.display());
         assert!(most <= 2, "{}: {most} solves in one call", path.display());

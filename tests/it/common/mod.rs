@@ -23,6 +23,20 @@ use mbfmu::model::parse::load_file;
 use std::path::PathBuf;
 use std::process::{Command, Output, Stdio};
 
+/// Every example model ([`model_files`]) in motion: simulated at tolerance 1e-10 from its
+/// experiment start for 0.05 s, with its path (the points the linearization route tests
+/// compare at).
+pub fn moving_examples() -> impl Iterator<Item = (PathBuf, Simulator)> {
+    model_files().into_iter().map(|path| {
+        let model = load_file(&path).unwrap_or_else(|e| panic!("{e}"));
+        let t0 = model.experiment.start.unwrap_or(0.0);
+        let opts = SimOptions { tol: 1e-10, max_step: None, ..Default::default() };
+        let mut sim = Simulator::new(&model, opts, t0).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        sim.advance(t0 + 0.05).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        (path, sim)
+    })
+}
+
 /// The crate's root directory.
 pub fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
