@@ -19,7 +19,7 @@ pub struct Simulator {
     /// The integrator, holding t, y and the step history.
     pub(super) radau: Radau,
     /// The factorization of the acceleration solve (reused across calls).
-    acc_lu: SparseLu,
+    pub(super) acc_lu: SparseLu,
     /// Accelerations and multipliers at the current time (None: not yet computed).
     pub(super) acc: Option<(Vec<f64>, Vec<f64>)>,
     /// What initialization wants the user to know (bodies that assembly moved far).

@@ -7,6 +7,7 @@
 #![allow(clippy::missing_safety_doc)]
 #![allow(non_snake_case)]
 
+use super::exchange::Interface;
 use super::guard::{get, guarded, slice, slice_mut, text, with_stack};
 use super::handle::{create, destroy};
 use super::instance::Instance;
@@ -79,7 +80,11 @@ pub unsafe extern "C" fn fmi2Instantiate(
             // SAFETY: NUL-terminated strings or NULL per FMI.
             let (model, guid, layout) =
                 name.and_then(|name| unsafe { instantiate(&name, fmuType, fmuGUID, fmuResourceLocation) })?;
-            Ok::<_, String>(Instance::new(model, guid, layout, Logger::new(loggingOn == TRUE), Standard::Fmi2))
+            let mut inst = Instance::new(model, guid, layout, Logger::new(loggingOn == TRUE), Standard::Fmi2);
+            if fmuType == MODEL_EXCHANGE {
+                inst.interface = Interface::ModelExchange;
+            }
+            Ok::<_, String>(inst)
         });
         match made {
             Ok(inst) => create(inst, sink),
@@ -104,17 +109,29 @@ unsafe fn instantiate(
     res_p: FmiString,
 ) -> Result<(crate::model::Model, String, crate::linearize::StateLayout), String> {
     let fail = |m: String| format!("instance '{name}': {m}");
-    match fmu_type {
-        CO_SIMULATION => {}
-        MODEL_EXCHANGE => return Err(fail("Model Exchange is not supported (Co-Simulation only)".into())),
-        t => return Err(fail(format!("unknown fmuType {t}"))),
+    if fmu_type != CO_SIMULATION && fmu_type != MODEL_EXCHANGE {
+        return Err(fail(format!("unknown fmuType {fmu_type}")));
     }
     // SAFETY: per this function's contract.
     let given = unsafe { text(guid_p, "fmuGUID") }.map_err(fail)?;
     // SAFETY: per this function's contract.
     let res = unsafe { text(res_p, "fmuResourceLocation") }.map_err(fail)?;
     let dir = file_uri_to_path(&res).map_err(fail)?;
-    super::resources::load(&dir, "fmuGUID", &given).map_err(fail)
+    let offers = super::resources::read_interfaces(&dir).map_err(fail)?;
+    let loaded = super::resources::load(&dir, "fmuGUID", &given).map_err(fail)?;
+    match fmu_type {
+        MODEL_EXCHANGE if !offers.model_exchange => {
+            Err(fail("this FMU was packed without Model Exchange (mbfmu pack --kind me or both)".into()))
+        }
+        MODEL_EXCHANGE if loaded.2.missing.is_some() => Err(fail(format!(
+            "Model Exchange needs the linearization states, and this model has none: {}",
+            loaded.2.missing.as_deref().unwrap_or("")
+        ))),
+        CO_SIMULATION if !offers.co_simulation => {
+            Err(fail("this FMU was packed without Co-Simulation (mbfmu pack --kind cs or both)".into()))
+        }
+        _ => Ok(loaded),
+    }
 }
 
 /// fmi2FreeInstance (2.1.5): release the instance and the FMU states it still holds

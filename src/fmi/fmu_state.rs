@@ -2,6 +2,7 @@
 //! state-machine state, the host's values and the engine state, and their byte form.
 
 use super::config::Config;
+use super::exchange::Exchange;
 use super::guid::checksum;
 use super::state_machine::State;
 use crate::dae::SimState;
@@ -23,11 +24,14 @@ pub struct FmuState {
     pub last_time: f64,
     /// The engine (None before initialization).
     pub sim: Option<SimState>,
+    /// Model Exchange: the time and states the host set (None: Co-Simulation).
+    pub exchange: Option<Exchange>,
 }
 
 impl FmuState {
     /// fmi2SerializeFMUstate: the magic `MBFMUF02`, GUID, state, configuration (with
-    /// `solver.maxSteps`), engine state, and a checksum of all before it.
+    /// `solver.maxSteps`), engine state, for Model Exchange [time, placed] and x, and a
+    /// checksum of all before it.
     pub fn to_bytes(&self) -> Vec<u8> {
         let mut w = ByteWriter::new(MAGIC);
         w.bytes(self.guid.as_bytes());
@@ -45,6 +49,10 @@ impl FmuState {
                 w.bytes(&s.to_bytes());
             }
             None => w.u8(0),
+        }
+        if let Some(e) = &self.exchange {
+            w.f64s(&[e.time, if e.placed { 1.0 } else { 0.0 }]);
+            w.f64s(&e.x);
         }
         let sum = checksum(w.as_slice());
         w.u64(sum);
@@ -74,12 +82,19 @@ impl FmuState {
             1 => Some(SimState::from_bytes(r.bytes().ok_or_else(bad)?).map_err(|e| e.to_string())?),
             _ => return Err(bad()),
         };
+        let exchange = if r.at_end() {
+            None
+        } else {
+            let th = r.f64s().filter(|h| h.len() == 2).ok_or_else(bad)?;
+            let x = r.f64s().ok_or_else(bad)?;
+            Some(Exchange { time: th[0], x, placed: th[1] == 1.0 })
+        };
         if head.len() != 4 || !r.at_end() {
             return Err(bad());
         }
         let stop = has_stop.then_some(head[2]);
         let config = Config { params, inputs, slopes, tol: head[0], start: head[1], stop, max_steps };
-        Ok(FmuState { guid, state, config, last_time: head[3], sim })
+        Ok(FmuState { guid, state, config, last_time: head[3], sim, exchange })
     }
 }
 

@@ -3,6 +3,7 @@
 //! exports only translate pointers and statuses.
 
 use super::config::Config;
+use super::exchange::{Exchange, Interface};
 use super::fmu_state::FmuState;
 use super::logger::Logger;
 use super::state_handles::StateHandles;
@@ -55,10 +56,14 @@ pub struct Instance {
     pub standard: Standard,
     /// FMI 3: the host uses Event Mode (`eventModeUsed`): initialization ends in it.
     pub event_mode: bool,
+    /// Co-Simulation (the engine integrates) or Model Exchange (the host does).
+    pub interface: Interface,
+    /// Model Exchange: the time and states the host set, and whether the engine is there.
+    pub exchange: Exchange,
     base: Model,
     /// The linearization states the FMU was packed with.
-    layout: StateLayout,
-    vars: Vec<Variable>,
+    pub(super) layout: StateLayout,
+    pub(super) vars: Vec<Variable>,
     /// The values and experiment the host chose.
     pub config: Config,
     /// The engine, once built.
@@ -90,6 +95,8 @@ impl Instance {
             guid,
             standard,
             event_mode: false,
+            interface: Interface::CoSimulation,
+            exchange: Exchange::default(),
             base,
             layout,
             vars,
@@ -119,6 +126,7 @@ impl Instance {
     pub fn reset(&mut self) {
         self.config = Self::default_config(&self.base);
         self.starts.clear();
+        self.exchange = Exchange::default();
         self.built = None;
         self.dirty = true;
         self.last_time = self.config.start;
@@ -279,6 +287,7 @@ impl Instance {
         for &vr in vrs {
             self.typed_var(vr, false)?;
         }
+        self.place_if_exchange()?;
         let mut have_outputs = false;
         let mut states: Option<crate::linearize::StateValues> = None;
         for (&vr, o) in vrs.iter().zip(out.iter_mut()) {
@@ -419,7 +428,10 @@ impl Instance {
                 _ => unreachable!("refused above"),
             }
         }
-        if moved {
+        if moved && self.interface == Interface::ModelExchange {
+            // Model Exchange: the point is solved anew, with the new inputs, when next read.
+            self.exchange.placed = false;
+        } else if moved {
             let sim = &mut self.built.as_mut().expect("initialized").sim;
             sim.resolve_user_unknowns().map_err(|e| format!("the user variables cannot follow the new inputs: {e}"))?;
         }
@@ -455,6 +467,7 @@ impl Instance {
         if let Some(v) = dv.iter().find(|v| !v.is_finite()) {
             return Err(format!("seed value {v} is not finite"));
         }
+        self.place_if_exchange()?;
         let lin = self.linearization()?;
         for (o, &r) in out.iter_mut().zip(&rows) {
             let mut acc = 0.0;
@@ -472,7 +485,7 @@ impl Instance {
     }
 
     /// The number of linearization states (columns of A).
-    fn state_count(&self) -> usize {
+    pub(super) fn state_count(&self) -> usize {
         self.vars.iter().filter(|v| v.known.is_some()).count()
     }
 
@@ -560,6 +573,9 @@ impl Instance {
 
     /// fmi2SetRealInputDerivatives (order 1 only: inputs change linearly over a step).
     pub fn set_input_derivatives(&mut self, vrs: &[u32], orders: &[i32], values: &[f64]) -> Result<(), String> {
+        if self.interface == Interface::ModelExchange {
+            return Err("input derivatives are a Co-Simulation function (in Model Exchange the host integrates)".into());
+        }
         let mut todo = Vec::with_capacity(vrs.len());
         for ((&vr, &order), &v) in vrs.iter().zip(orders).zip(values) {
             let var = self.var(vr)?;
@@ -593,7 +609,12 @@ impl Instance {
     pub fn exit_initialization(&mut self) -> Result<(), String> {
         let t = self.simulator()?.time();
         self.last_time = t;
-        self.state = State::StepComplete;
+        if self.interface == Interface::ModelExchange {
+            self.start_exchange()?;
+            self.state = State::EventMode;
+        } else {
+            self.state = State::StepComplete;
+        }
         Ok(())
     }
 
@@ -677,6 +698,7 @@ impl Instance {
             config: self.config.clone(),
             last_time: self.last_time,
             sim: if self.dirty { None } else { self.built.as_ref().map(|b| b.sim.snapshot()) },
+            exchange: (self.interface == Interface::ModelExchange).then(|| self.exchange.clone()),
         }
     }
 
@@ -685,6 +707,15 @@ impl Instance {
     pub fn restore_state(&mut self, saved: &FmuState) -> Result<(), String> {
         if saved.guid != self.guid {
             return Err(format!("the state belongs to FMU {}, not to this FMU {}", saved.guid, self.guid));
+        }
+        let saved_me = saved.exchange.is_some();
+        if saved_me != (self.interface == Interface::ModelExchange) {
+            let name = |me: bool| if me { "Model Exchange" } else { "Co-Simulation" };
+            return Err(format!(
+                "the state was saved by a {} instance; this one is {}",
+                name(saved_me),
+                name(!saved_me)
+            ));
         }
         match &saved.sim {
             None => {
@@ -709,6 +740,7 @@ impl Instance {
         self.config = saved.config.clone();
         self.last_time = saved.last_time;
         self.state = saved.state;
+        self.exchange = saved.exchange.clone().unwrap_or_default();
         Ok(())
     }
 }

@@ -1,10 +1,12 @@
-//! The FMI Co-Simulation layer, what runs inside a host: one thin shell over the engine
-//! (handles, guard, state-machine table, instance, logger) under two tables of exports,
-//! FMI 2.0 (`exports_*`) and FMI 3.0 (`exports3_*`). It maps value references, enforces
+//! The FMI layer, what runs inside a host: one thin shell over the engine (handles,
+//! guard, state-machine table, instance, logger) under two tables of exports, FMI 2.0
+//! (`exports_*`: Co-Simulation and Model Exchange) and FMI 3.0 (`exports3_*`:
+//! Co-Simulation). It maps value references, enforces
 //! the state machine, logs, and calls the engine; it computes nothing itself. The
 //! build-time packer is [`crate::pack`].
 
 pub mod config;
+pub mod exchange;
 pub mod exports3_common;
 pub mod exports3_cs;
 pub mod exports3_other;

@@ -19,6 +19,55 @@ pub const START_VALUES_FILE: &str = "start_values.txt";
 /// The model file in the FMU's resources directory.
 pub const MODEL_FILE: &str = "model.xml";
 
+/// The file naming the interfaces the FMU was packed with, one a line
+/// (`ModelExchange`, `CoSimulation`); an FMU without it is Co-Simulation only.
+pub const INTERFACES_FILE: &str = "interfaces.txt";
+
+/// The interfaces an FMU offers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Interfaces {
+    /// Model Exchange.
+    pub model_exchange: bool,
+    /// Co-Simulation.
+    pub co_simulation: bool,
+}
+
+impl Interfaces {
+    /// The file's text.
+    pub fn to_text(self) -> String {
+        let mut t = String::new();
+        if self.model_exchange {
+            t += "ModelExchange\n";
+        }
+        if self.co_simulation {
+            t += "CoSimulation\n";
+        }
+        t
+    }
+}
+
+/// The interfaces of the FMU whose resources directory is `resources`.
+pub fn read_interfaces(resources: &Path) -> Result<Interfaces, String> {
+    let file = resources.join(INTERFACES_FILE);
+    let text = match std::fs::read_to_string(&file) {
+        Ok(t) => t,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            return Ok(Interfaces { model_exchange: false, co_simulation: true });
+        }
+        Err(e) => return Err(format!("cannot read {}: {e}", file.display())),
+    };
+    let mut out = Interfaces { model_exchange: false, co_simulation: false };
+    for (n, line) in text.lines().enumerate() {
+        match line.trim() {
+            "ModelExchange" => out.model_exchange = true,
+            "CoSimulation" => out.co_simulation = true,
+            "" => {}
+            other => return Err(format!("{}:{}: unknown interface '{other}'", file.display(), n + 1)),
+        }
+    }
+    Ok(out)
+}
+
 /// The state layout of the FMU whose resources directory is `resources` and whose model
 /// has the GUID `guid` (read at instantiation; no engine run).
 pub fn read_layout(resources: &Path, guid: &str) -> Result<StateLayout, String> {

@@ -1,12 +1,15 @@
-//! The Co-Simulation state machines of FMI 2.0 (4.2.4 State Machine of Calling Sequence
-//! from Master to Slave) and FMI 3.0 (4.3 Co-Simulation state machine): one const table of
+//! The state machines of FMI 2.0 Co-Simulation (4.2.4 State Machine of Calling Sequence
+//! from Master to Slave) and Model Exchange (3.2.3) and FMI 3.0 Co-Simulation (4.3):
+//! the FMI 2 column joins both FMI 2 machines (their states are disjoint after
+//! initialization: a Co-Simulation instance never enters Event or Continuous-Time Mode,
+//! a Model Exchange one never StepComplete). One const table of
 //! each function's C names and the states in which it may be called, a column per FMI
 //! version (where the two differ, the table says so), and one guard every export runs
 //! first.
 
 use super::variables::Standard;
 
-/// A state of a Co-Simulation instance; each is one bit so a set of states is a mask.
+/// A state of an instance; each is one bit so a set of states is a mask.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum State {
     /// instantiated: after fmi2Instantiate or fmi2Reset, before
@@ -29,9 +32,14 @@ pub enum State {
     /// fatal: after a panic in a function that may have left the engine half-updated;
     /// only fmi2FreeInstance is allowed.
     Fatal = 128,
-    /// FMI 3 Event Mode (after fmi3ExitInitializationMode when the host uses event mode,
-    /// or fmi3EnterEventMode): nothing happens there, the model has no events.
+    /// Event Mode: FMI 3 Co-Simulation (after fmi3ExitInitializationMode when the host
+    /// uses event mode, or fmi3EnterEventMode) and FMI 2 Model Exchange (after
+    /// fmi2ExitInitializationMode, or fmi2EnterEventMode): nothing happens there, the
+    /// model has no events.
     EventMode = 256,
+    /// FMI 2 Model Exchange Continuous-Time Mode: the host sets time and states and reads
+    /// derivatives.
+    ContinuousTimeMode = 512,
 }
 
 impl State {
@@ -42,7 +50,7 @@ impl State {
 
     /// Every state, for decoding a serialized state (new states go last: a state's
     /// position is its code).
-    pub const ALL: [State; 9] = [
+    pub const ALL: [State; 10] = [
         State::Instantiated,
         State::InitializationMode,
         State::StepComplete,
@@ -52,6 +60,7 @@ impl State {
         State::Error,
         State::Fatal,
         State::EventMode,
+        State::ContinuousTimeMode,
     ];
 }
 
@@ -64,12 +73,19 @@ const TERM: u32 = State::Terminated.bit();
 const ERR: u32 = State::Error.bit();
 const FATAL: u32 = State::Fatal.bit();
 const EVENT: u32 = State::EventMode.bit();
+const CONT: u32 = State::ContinuousTimeMode.bit();
 /// Every state but Fatal.
-const ALIVE: u32 = INST | INIT | DONE | FAIL | CANC | TERM | ERR | EVENT;
+const ALIVE: u32 = INST | INIT | DONE | FAIL | CANC | TERM | ERR | EVENT | CONT;
 /// Not a function of this FMI version.
 const NONE: u32 = 0;
 /// States with values to read.
 const READABLE: u32 = INIT | DONE | FAIL | CANC | TERM | ERR;
+/// States with values to read in FMI 2 (Co-Simulation and Model Exchange).
+const READABLE2: u32 = READABLE | EVENT | CONT;
+/// States in which FMI 2 hosts set values (Co-Simulation and Model Exchange).
+const SETTABLE2: u32 = INST | INIT | DONE | EVENT | CONT;
+/// Model Exchange states in which the states and indicators can be read.
+const ME_READABLE: u32 = INIT | EVENT | CONT | TERM | ERR;
 
 /// An FMI function that takes an instance.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -144,6 +160,24 @@ pub enum Func {
     EnterStepMode,
     /// `fmi3UpdateDiscreteStates`.
     UpdateDiscreteStates,
+    /// `fmi2NewDiscreteStates`.
+    NewDiscreteStates,
+    /// `fmi2EnterContinuousTimeMode`.
+    EnterContinuousTimeMode,
+    /// `fmi2CompletedIntegratorStep`.
+    CompletedIntegratorStep,
+    /// `fmi2SetTime`.
+    SetTime,
+    /// `fmi2SetContinuousStates`.
+    SetContinuousStates,
+    /// `fmi2GetDerivatives`.
+    GetDerivatives,
+    /// `fmi2GetEventIndicators`.
+    GetEventIndicators,
+    /// `fmi2GetContinuousStates`.
+    GetContinuousStates,
+    /// `fmi2GetNominalsOfContinuousStates`.
+    GetNominalsOfContinuousStates,
     /// The FMI 3 functions of what this FMU does not have (other variable types, clocks,
     /// configuration mode, Model Exchange, …): refused in any state with a message naming
     /// the function.
@@ -180,9 +214,9 @@ const READABLE3: u32 = READABLE | EVENT;
 /// States in which FMI 3 hosts set values.
 const SETTABLE3: u32 = INST | INIT | DONE | EVENT;
 
-/// Allowed states per function, in `Func` order: FMI 2 masks follow the FMI 2.0 CS state
-/// machine, FMI 3 masks the FMI 3.0 CS one, both as modelica/Reference-FMUs encodes them.
-pub const RULES: [Rule; 36] = [
+/// Allowed states per function, in `Func` order: FMI 2 masks follow the FMI 2.0 CS and ME
+/// state machines, FMI 3 masks the FMI 3.0 CS one, as modelica/Reference-FMUs encodes them.
+pub const RULES: [Rule; 45] = [
     rule(Func::SetDebugLogging, ("fmi2SetDebugLogging", ALIVE), ("fmi3SetDebugLogging", ALIVE), false),
     rule(Func::FreeInstance, ("fmi2FreeInstance", ALIVE | FATAL), ("fmi3FreeInstance", ALIVE | FATAL), false),
     rule(Func::SetupExperiment, ("fmi2SetupExperiment", INST), ("", NONE), false),
@@ -198,16 +232,21 @@ pub const RULES: [Rule; 36] = [
         ("fmi3ExitInitializationMode", INIT),
         true,
     ),
-    rule(Func::Terminate, ("fmi2Terminate", DONE | FAIL | ERR), ("fmi3Terminate", DONE | FAIL | ERR | EVENT), false),
+    rule(
+        Func::Terminate,
+        ("fmi2Terminate", DONE | FAIL | ERR | EVENT | CONT),
+        ("fmi3Terminate", DONE | FAIL | ERR | EVENT),
+        false,
+    ),
     rule(Func::Reset, ("fmi2Reset", ALIVE), ("fmi3Reset", ALIVE), true),
-    rule(Func::GetReal, ("fmi2GetReal", READABLE), ("fmi3GetFloat64", READABLE3), false),
-    rule(Func::GetInteger, ("fmi2GetInteger", READABLE), ("fmi3GetInt32", READABLE3), false),
-    rule(Func::GetBoolean, ("fmi2GetBoolean", READABLE), ("fmi3GetBoolean", READABLE3), false),
-    rule(Func::GetString, ("fmi2GetString", READABLE), ("fmi3GetString", READABLE3), false),
-    rule(Func::SetReal, ("fmi2SetReal", INST | INIT | DONE), ("fmi3SetFloat64", SETTABLE3), true),
-    rule(Func::SetInteger, ("fmi2SetInteger", INST | INIT | DONE), ("fmi3SetInt32", SETTABLE3), false),
-    rule(Func::SetBoolean, ("fmi2SetBoolean", INST | INIT | DONE), ("fmi3SetBoolean", SETTABLE3), false),
-    rule(Func::SetString, ("fmi2SetString", INST | INIT | DONE), ("fmi3SetString", SETTABLE3), false),
+    rule(Func::GetReal, ("fmi2GetReal", READABLE2), ("fmi3GetFloat64", READABLE3), false),
+    rule(Func::GetInteger, ("fmi2GetInteger", READABLE2), ("fmi3GetInt32", READABLE3), false),
+    rule(Func::GetBoolean, ("fmi2GetBoolean", READABLE2), ("fmi3GetBoolean", READABLE3), false),
+    rule(Func::GetString, ("fmi2GetString", READABLE2), ("fmi3GetString", READABLE3), false),
+    rule(Func::SetReal, ("fmi2SetReal", SETTABLE2), ("fmi3SetFloat64", SETTABLE3), true),
+    rule(Func::SetInteger, ("fmi2SetInteger", INST | INIT | DONE | EVENT), ("fmi3SetInt32", SETTABLE3), false),
+    rule(Func::SetBoolean, ("fmi2SetBoolean", INST | INIT | DONE | EVENT), ("fmi3SetBoolean", SETTABLE3), false),
+    rule(Func::SetString, ("fmi2SetString", INST | INIT | DONE | EVENT), ("fmi3SetString", SETTABLE3), false),
     rule(Func::GetFmuState, ("fmi2GetFMUstate", ALIVE), ("fmi3GetFMUState", ALIVE), false),
     rule(Func::SetFmuState, ("fmi2SetFMUstate", ALIVE), ("fmi3SetFMUState", ALIVE), true),
     rule(Func::FreeFmuState, ("fmi2FreeFMUstate", ALIVE), ("fmi3FreeFMUState", ALIVE), false),
@@ -221,7 +260,7 @@ pub const RULES: [Rule; 36] = [
     rule(Func::DeSerializeFmuState, ("fmi2DeSerializeFMUstate", ALIVE), ("fmi3DeserializeFMUState", ALIVE), false),
     rule(
         Func::GetDirectionalDerivative,
-        ("fmi2GetDirectionalDerivative", READABLE),
+        ("fmi2GetDirectionalDerivative", READABLE2),
         ("fmi3GetDirectionalDerivative", INIT | DONE | FAIL | TERM | EVENT),
         false,
     ),
@@ -245,9 +284,23 @@ pub const RULES: [Rule; 36] = [
         ("fmi3GetAdjointDerivative", INIT | DONE | FAIL | TERM | EVENT),
         false,
     ),
-    rule(Func::EnterEventMode, ("", NONE), ("fmi3EnterEventMode", DONE), false),
+    rule(Func::EnterEventMode, ("fmi2EnterEventMode", EVENT | CONT), ("fmi3EnterEventMode", DONE), false),
     rule(Func::EnterStepMode, ("", NONE), ("fmi3EnterStepMode", EVENT), false),
     rule(Func::UpdateDiscreteStates, ("", NONE), ("fmi3UpdateDiscreteStates", EVENT), false),
+    rule(Func::NewDiscreteStates, ("fmi2NewDiscreteStates", EVENT), ("", NONE), false),
+    rule(Func::EnterContinuousTimeMode, ("fmi2EnterContinuousTimeMode", EVENT), ("", NONE), false),
+    rule(Func::CompletedIntegratorStep, ("fmi2CompletedIntegratorStep", CONT), ("", NONE), true),
+    rule(Func::SetTime, ("fmi2SetTime", EVENT | CONT), ("", NONE), false),
+    rule(Func::SetContinuousStates, ("fmi2SetContinuousStates", CONT), ("", NONE), false),
+    rule(Func::GetDerivatives, ("fmi2GetDerivatives", EVENT | CONT | TERM | ERR), ("", NONE), true),
+    rule(Func::GetEventIndicators, ("fmi2GetEventIndicators", ME_READABLE), ("", NONE), false),
+    rule(Func::GetContinuousStates, ("fmi2GetContinuousStates", ME_READABLE), ("", NONE), false),
+    rule(
+        Func::GetNominalsOfContinuousStates,
+        ("fmi2GetNominalsOfContinuousStates", INST | EVENT | CONT | TERM | ERR),
+        ("", NONE),
+        false,
+    ),
     rule(Func::Unsupported, ("", NONE), ("an FMI 3 function", ALIVE), false),
 ];
 

@@ -96,3 +96,22 @@ pub struct CallbackFunctions {
     /// as the logger's first argument.
     pub component_environment: ComponentEnvironment,
 }
+
+/// fmi2EventInfo (3.2.2 Evaluation of the Model Equations), filled by
+/// fmi2NewDiscreteStates.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct EventInfo {
+    /// `newDiscreteStatesNeeded`.
+    pub new_discrete_states_needed: Boolean,
+    /// `terminateSimulation`.
+    pub terminate_simulation: Boolean,
+    /// `nominalsOfContinuousStatesChanged`.
+    pub nominals_changed: Boolean,
+    /// `valuesOfContinuousStatesChanged`.
+    pub values_changed: Boolean,
+    /// `nextEventTimeDefined`.
+    pub next_event_time_defined: Boolean,
+    /// `nextEventTime`.
+    pub next_event_time: Real,
+}

@@ -7,6 +7,7 @@ pub mod augmented;
 pub mod candidates;
 pub mod eigen;
 pub mod eq34;
+pub mod exchange;
 pub mod extract;
 pub mod jets;
 pub mod layout;

@@ -1,4 +1,4 @@
-//! `modelDescription.xml` of a model's FMI 2.0 Co-Simulation FMU.
+//! `modelDescription.xml` of a model's FMI 2.0 FMU (Model Exchange and/or Co-Simulation).
 //!
 //! The variables and their value references come from [`crate::fmi::variables`] (shared with
 //! the C API). `<ModelStructure>` writes the dependencies of
@@ -12,6 +12,7 @@ use super::structure::unknowns;
 use super::xml::{attr_line, escape, real, with_state_starts, write_experiment, write_units};
 
 use crate::fmi::guid::{ENGINE_VERSION, guid, model_identifier};
+use crate::fmi::resources::Interfaces;
 use crate::fmi::variables::{Causality, Standard, Variable, variables};
 use crate::linearize::{FmuLinearization, ModelStructure, StateLayout, StateValues, for_fmu};
 use crate::model::Model;
@@ -21,19 +22,21 @@ use crate::model::Model;
 /// [`describe`].
 pub fn write(model: &Model, model_text: &str) -> String {
     let FmuLinearization { layout, structure, starts } = for_fmu(model);
-    describe(model, &guid(model, model_text), &layout, &structure, &starts)
+    let interfaces = super::Kind::Both.interfaces(Standard::Fmi2, &layout).map_or(super::CO_SIMULATION, |(i, _)| i);
+    describe(model, &guid(model, model_text), &layout, &structure, &starts, interfaces)
 }
 
 /// The modelDescription.xml of the FMU of `model` with the GUID `guid` (see
 /// [`crate::fmi::guid`]; `model` is the model as the FMU starts, start values applied), the
 /// linearization states `layout` and the dependencies `structure` (of the same selection,
-/// see [`for_fmu`]).
+/// see [`for_fmu`]), offering the `interfaces`.
 pub fn describe(
     model: &Model,
     guid: &str,
     layout: &StateLayout,
     structure: &ModelStructure,
     starts: &StateValues,
+    interfaces: Interfaces,
 ) -> String {
     let vars = with_state_starts(variables(model, layout, Standard::Fmi2), model, layout, starts);
     let mut x = String::new();
@@ -47,21 +50,36 @@ pub fn describe(
     attr_line(&mut x, "variableNamingConvention", "structured");
     x.push_str("  numberOfEventIndicators=\"0\">\n");
 
-    x.push_str("  <CoSimulation\n");
     let id = model_identifier(&model.name);
-    for (name, value) in [
-        ("modelIdentifier", id.as_str()),
-        ("canHandleVariableCommunicationStepSize", "true"),
-        ("canGetAndSetFMUstate", "true"),
-        ("canSerializeFMUstate", "true"),
-        ("canInterpolateInputs", "true"),
-        ("maxOutputDerivativeOrder", "1"),
-        ("canNotUseMemoryManagementFunctions", "true"),
-    ] {
-        x.push_str("  ");
-        attr_line(&mut x, name, value);
+    if interfaces.model_exchange {
+        x.push_str("  <ModelExchange\n");
+        for (name, value) in [
+            ("modelIdentifier", id.as_str()),
+            ("canGetAndSetFMUstate", "true"),
+            ("canSerializeFMUstate", "true"),
+            ("canNotUseMemoryManagementFunctions", "true"),
+        ] {
+            x.push_str("  ");
+            attr_line(&mut x, name, value);
+        }
+        x.push_str("    providesDirectionalDerivative=\"true\"/>\n");
     }
-    x.push_str("    providesDirectionalDerivative=\"true\"/>\n");
+    if interfaces.co_simulation {
+        x.push_str("  <CoSimulation\n");
+        for (name, value) in [
+            ("modelIdentifier", id.as_str()),
+            ("canHandleVariableCommunicationStepSize", "true"),
+            ("canGetAndSetFMUstate", "true"),
+            ("canSerializeFMUstate", "true"),
+            ("canInterpolateInputs", "true"),
+            ("maxOutputDerivativeOrder", "1"),
+            ("canNotUseMemoryManagementFunctions", "true"),
+        ] {
+            x.push_str("  ");
+            attr_line(&mut x, name, value);
+        }
+        x.push_str("    providesDirectionalDerivative=\"true\"/>\n");
+    }
 
     write_units(&mut x, &vars);
     write_experiment(&mut x, model);

@@ -39,7 +39,7 @@ use zip::write::SimpleFileOptions;
 
 use crate::dae::StartValues;
 use crate::fmi::guid::{guid, guid_with, model_identifier};
-use crate::fmi::resources::{LAYOUT_FILE, START_VALUES_FILE};
+use crate::fmi::resources::{INTERFACES_FILE, Interfaces, LAYOUT_FILE, START_VALUES_FILE};
 use crate::fmi::variables::Standard;
 use crate::linearize::{FmuLinearization, StateLayout, for_fmu};
 use crate::model::overrides::start_values_text;
@@ -80,6 +80,9 @@ pub enum PackError {
     /// The FMU's shared library was not found.
     #[error("{0}")]
     LibraryNotFound(String),
+    /// The FMU asked for cannot be made of this model (bad request).
+    #[error("{0}")]
+    Unsupported(String),
     /// Reading or writing a file failed.
     #[error("{context}: {source}")]
     Io {
@@ -93,6 +96,47 @@ pub enum PackError {
 fn io_err(context: impl Into<String>) -> impl FnOnce(std::io::Error) -> PackError {
     let context = context.into();
     move |source| PackError::Io { context, source }
+}
+
+/// Co-Simulation only (an FMU that cannot offer Model Exchange).
+pub const CO_SIMULATION: Interfaces = Interfaces { model_exchange: false, co_simulation: true };
+
+/// Which interfaces `mbfmu pack --kind` asks for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    /// Model Exchange only.
+    ModelExchange,
+    /// Co-Simulation only.
+    CoSimulation,
+    /// Both, in one FMU (the default).
+    Both,
+}
+
+impl Kind {
+    /// The interfaces an FMU of FMI version `standard` with the linearization states
+    /// `layout` offers for this kind, and a warning when `Both` has to drop Model
+    /// Exchange; an error when the kind cannot be had (Model Exchange needs the
+    /// linearization states as its continuous states, and is FMI 2.0 only for now).
+    pub fn interfaces(
+        self,
+        standard: Standard,
+        layout: &StateLayout,
+    ) -> Result<(Interfaces, Option<String>), PackError> {
+        let me = matches!(self, Kind::ModelExchange | Kind::Both);
+        let cs = matches!(self, Kind::CoSimulation | Kind::Both);
+        let why_not = match (standard, &layout.missing) {
+            (Standard::Fmi3, _) => Some("FMI 3.0 Model Exchange is not available yet (use --fmi 2)".to_string()),
+            (_, Some(why)) => Some(format!("the model has no linearization states to be its continuous states: {why}")),
+            _ => None,
+        };
+        match (me, why_not) {
+            (true, Some(why)) if !cs => Err(PackError::Unsupported(format!("--kind me: {why}"))),
+            // FMI 3: Co-Simulation is what `both` means until its Model Exchange exists.
+            (true, Some(_)) if standard == Standard::Fmi3 => Ok((CO_SIMULATION, None)),
+            (true, Some(why)) => Ok((CO_SIMULATION, Some(format!("Co-Simulation only: {why}")))),
+            _ => Ok((Interfaces { model_exchange: me, co_simulation: cs }, None)),
+        }
+    }
 }
 
 /// What was packed.
@@ -168,7 +212,7 @@ pub fn library() -> Result<Vec<u8>, PackError> {
 }
 
 /// Load the model and gather every file of its FMU, with the start values `set`.
-fn contents(model_path: &Path, set: &[(String, f64)], standard: Standard) -> Result<Contents, PackError> {
+fn contents(model_path: &Path, set: &[(String, f64)], standard: Standard, kind: Kind) -> Result<Contents, PackError> {
     let label = model_path.display().to_string();
     let bytes = std::fs::read(model_path).map_err(|e| ModelError {
         file: label.clone(),
@@ -193,9 +237,10 @@ fn contents(model_path: &Path, set: &[(String, f64)], standard: Standard) -> Res
     let lib = library()?;
     let FmuLinearization { layout, structure, starts } = for_fmu(&model);
     let guid = guid_with(&base, text, &start_values);
+    let (interfaces, dropped) = kind.interfaces(standard, &layout)?;
     let (xml, platform) = match standard {
         Standard::Fmi2 => {
-            (fmi2_description::describe(&model, &guid, &layout, &structure, &starts), PLATFORM.to_string())
+            (fmi2_description::describe(&model, &guid, &layout, &structure, &starts, interfaces), PLATFORM.to_string())
         }
         Standard::Fmi3 => (fmi3_description::describe(&model, &guid, &layout, &structure, &starts), platform_tuple()),
     };
@@ -203,12 +248,14 @@ fn contents(model_path: &Path, set: &[(String, f64)], standard: Standard) -> Res
         .missing
         .iter()
         .map(|why| format!("the FMU has no linearization states (fmi2GetDirectionalDerivative will fail): {why}"))
+        .chain(dropped)
         .collect();
     let mut files = vec![
         ("modelDescription.xml".to_string(), xml.into_bytes()),
         (format!("binaries/{platform}/{id}.{LIB_EXT}"), lib),
         ("resources/model.xml".to_string(), bytes.clone()),
         (format!("resources/{LAYOUT_FILE}"), layout.to_text(&guid).into_bytes()),
+        (format!("resources/{INTERFACES_FILE}"), interfaces.to_text().into_bytes()),
     ];
     if !start_values.is_empty() {
         files.push((format!("resources/{START_VALUES_FILE}"), start_values.into_bytes()));
@@ -267,7 +314,7 @@ pub fn layout_file(model_text: &str, label: &str) -> Result<(Vec<u8>, Option<Str
 
 /// Write the FMU of the model file `model_path` as the zip archive `out` (replacing it).
 pub fn pack_fmu(model_path: &Path, out: &Path) -> Result<Packed, PackError> {
-    let c = contents(model_path, &[], Standard::Fmi2)?;
+    let c = contents(model_path, &[], Standard::Fmi2, Kind::Both)?;
     write_zip(&c, out)?;
     Ok(c.packed)
 }
@@ -275,26 +322,28 @@ pub fn pack_fmu(model_path: &Path, out: &Path) -> Result<Packed, PackError> {
 /// Write the FMU of the model file `model_path` unzipped into the directory `dir`
 /// (created if needed; files of the same names are replaced).
 pub fn pack_dir(model_path: &Path, dir: &Path) -> Result<Packed, PackError> {
-    let c = contents(model_path, &[], Standard::Fmi2)?;
+    let c = contents(model_path, &[], Standard::Fmi2, Kind::Both)?;
     write_dir(&c, dir)?;
     Ok(c.packed)
 }
 
 /// Pack both ways at once (either may be `None`); the model is loaded once.
 pub fn pack(model_path: &Path, fmu: Option<&Path>, dir: Option<&Path>) -> Result<Packed, PackError> {
-    pack_with(model_path, &[], Standard::Fmi2, fmu, dir)
+    pack_with(model_path, &[], Standard::Fmi2, Kind::Both, fmu, dir)
 }
 
 /// [`pack`] with the start values `set` (`NAME=VALUE` pairs, [`crate::model::overrides`])
-/// instead of the model file's values, as an FMU of FMI version `standard`.
+/// instead of the model file's values, as an FMU of FMI version `standard` offering the
+/// interfaces of `kind`.
 pub fn pack_with(
     model_path: &Path,
     set: &[(String, f64)],
     standard: Standard,
+    kind: Kind,
     fmu: Option<&Path>,
     dir: Option<&Path>,
 ) -> Result<Packed, PackError> {
-    let c = contents(model_path, set, standard)?;
+    let c = contents(model_path, set, standard, kind)?;
     if let Some(out) = fmu {
         write_zip(&c, out)?;
     }

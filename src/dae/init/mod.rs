@@ -5,6 +5,8 @@
 //!   consistent ([`gauss_newton`], least-norm corrections [I C_qᵀ; C_q 0]), then the
 //!   exact conditions reached along a path ([`continuation`]), every joint's orientation
 //!   checked ([`orientation`]);
+//! - [`placement`]: Model Exchange's coordinate partitioning: the positions at which
+//!   given position states hold, by Newton from the last consistent point;
 //! - [`statics`]: static equilibrium instead, when the model asks for it;
 //! - [`velocities`]: consistent velocities closest to the given ones (P u + C_t = 0,
 //!   B u + b = 0, the velocity ICs);
@@ -21,6 +23,7 @@ mod continuation;
 mod gauss_newton;
 mod kkt;
 mod orientation;
+pub mod placement;
 pub mod positions;
 pub mod redundancy;
 pub mod statics;
@@ -29,8 +32,9 @@ pub mod velocities;
 
 pub use accelerations::accelerations;
 pub use algebraic_loop::consistent_accelerations;
+pub use placement::place_positions;
 pub use positions::{Assembly, InitError, assemble_positions};
 pub use redundancy::{REDUNDANCY_TOL, redundant_rows};
 pub use statics::static_equilibrium;
 pub use user_unknowns::user_unknowns;
-pub use velocities::assemble_velocities;
+pub use velocities::{assemble_velocities, assemble_velocities_with};

@@ -14,7 +14,21 @@ use crate::mechanics::nonholonomic_jacobian::nonholonomic_b;
 
 /// Consistent velocities: u closest to `u` with P u + C_t = 0 and exact velocity ICs.
 pub fn assemble_velocities(sys: &System, q: &[f64], u: &mut [f64], t: f64, inputs: &[f64]) -> Result<(), String> {
-    let (n, m, nic, mn) = (sys.n(), sys.m, sys.ic_velocities.len(), sys.mn);
+    assemble_velocities_with(sys, &sys.ic_velocities, q, u, t, inputs)
+}
+
+/// [`assemble_velocities`] with the velocity conditions `ics` instead of the system's own
+/// (Model Exchange: the velocity states the host sets; with as many conditions as the
+/// velocities have freedoms, u is the unique solution).
+pub fn assemble_velocities_with(
+    sys: &System,
+    ics: &[VelocityIc],
+    q: &[f64],
+    u: &mut [f64],
+    t: f64,
+    inputs: &[f64],
+) -> Result<(), String> {
+    let (n, m, nic, mn) = (sys.n(), sys.m, ics.len(), sys.mn);
     // Rows: u (n), constraints (m), velocity ICs (nic), non-holonomic (mn).
     let (ic0, nh0, dim) = (n + m, n + m + nic, n + m + nic + mn);
     let mut kkt = Triplets::new();
@@ -36,7 +50,7 @@ pub fn assemble_velocities(sys: &System, q: &[f64], u: &mut [f64], t: f64, input
         kkt.push(c, nh0 + r, v);
         rhs[nh0 + r] += v * u[c];
     }
-    for (k, ic) in sys.ic_velocities.iter().enumerate() {
+    for (k, ic) in ics.iter().enumerate() {
         let (res, a) = velocity_ic_row(sys, ic, q, u, t, inputs);
         let r = ic0 + k;
         let mut au = 0.0;
@@ -51,7 +65,7 @@ pub fn assemble_velocities(sys: &System, q: &[f64], u: &mut [f64], t: f64, input
     // Velocity conditions that conflict with each other or with the constraints make the
     // system singular: name them.
     let conditions = || {
-        let names: Vec<String> = sys.ic_velocities.iter().map(|ic| format!("'{}' = {}", ic.name, ic.value)).collect();
+        let names: Vec<String> = ics.iter().map(|ic| format!("'{}' = {}", ic.name, ic.value)).collect();
         if names.is_empty() { String::new() } else { format!(" (velocity conditions: {})", names.join(", ")) }
     };
     let mut lu = SparseLu::new();
