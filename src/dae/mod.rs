@@ -25,7 +25,7 @@ mod start_values;
 pub use error::EngineError;
 pub use observe::BodyState;
 pub use options::SimOptions;
-pub use partitioned::PLACEMENT_TOL;
+pub use partitioned::{Check, PLACEMENT_TOL};
 pub use radau::{BATCH_MAX_STEPS, DEFAULT_MAX_STEPS};
 pub use simulator::Simulator;
 pub use snapshot::SimState;

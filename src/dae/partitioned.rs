@@ -7,10 +7,17 @@ use super::error::EngineError;
 use super::init;
 use super::simulator::Simulator;
 use super::start_values::StartValues;
+use crate::mechanics::System;
+use crate::mechanics::measures::StateKind;
+use crate::model::expr::Expr;
 
 /// Largest |C| (and |s − S|) of a placed point, relative to the model's size 1 + max|q|:
 /// near round-off, so that derivatives the host differentiates are smooth in the states.
 pub const PLACEMENT_TOL: f64 = 1e-12;
+
+/// What [`Simulator::place`] asks of a point before moving there: (system, q, t,
+/// external values) → acceptable or why not.
+pub type Check<'a> = &'a dyn Fn(&System, &[f64], f64, &[f64]) -> Result<(), EngineError>;
 
 impl Simulator {
     /// Move the engine to time `t` and the point where the values `set` hold: positions
@@ -19,12 +26,40 @@ impl Simulator {
     /// ([`init::assemble_velocities_with`]), the differential states X as given, then Ẋ,
     /// V, the accelerations and multipliers (Eq. 1c–1d, 7). `set` must hold as many
     /// position and velocity conditions as the mechanism has freedoms there (the
-    /// linearization states); the integrator's history is dropped. On an error the
-    /// engine is where it was.
-    pub fn place(&mut self, t: f64, set: &StartValues) -> Result<(), EngineError> {
+    /// linearization states); `check` is asked, with the system, the new q, t and the
+    /// external values, whether that point is acceptable before the engine moves there
+    /// (the states still parameterize it). The integrator's history is dropped. On an
+    /// error the engine is where it was.
+    pub fn place(&mut self, t: f64, set: &StartValues, check: Check) -> Result<(), EngineError> {
         if !t.is_finite() {
             return Err(EngineError::Numeric(format!("time {t} is not finite")));
         }
+        let sys = &mut self.dae.sys;
+        let kept = (sys.angle_refs.clone(), sys.angle_time);
+        // The host's states say where the mechanism is, not the time: angle measures stay
+        // on the branches of the last point (no extrapolation with their rates to t), and
+        // a state that is an angle measure is put on the branch of its value, however far
+        // the host moved it (a fast rotor over a long step).
+        sys.angle_time = t;
+        for p in &set.positions {
+            if let StateKind::Joint { f: Expr::Kin(k, ..), abase, .. } | StateKind::User { f: Expr::Kin(k, ..), abase } =
+                &p.kind
+                && k.is_angle()
+                && let Some(r) = sys.angle_refs.get_mut(*abase)
+            {
+                *r = p.value;
+            }
+        }
+        let placed = self.place_at(t, set, check);
+        if placed.is_err() {
+            let sys = &mut self.dae.sys;
+            (sys.angle_refs, sys.angle_time) = kept;
+        }
+        placed
+    }
+
+    /// [`Simulator::place`] once the angle branches are set.
+    fn place_at(&mut self, t: f64, set: &StartValues, check: Check) -> Result<(), EngineError> {
         let lay = self.dae.lay;
         let inputs = self.dae.inputs_at(t);
         let sys = &self.dae.sys;
@@ -54,6 +89,7 @@ impl Simulator {
         if let Some(v) = y.iter().find(|v| !v.is_finite()) {
             return Err(EngineError::Numeric(format!("the motion at t = {t} is not finite ({v})")));
         }
+        check(sys, &q, t, &lay.ext(sys, &inputs, &y, t))?;
         // Euler frames re-based and angle branches recorded, as after an accepted step.
         super::radau::DaeProblem::accepted(&mut self.dae, t, &mut y);
         self.radau.t = t;

@@ -5,27 +5,8 @@
 //! records them; the point is solved once, when something is read there.
 
 use super::instance::Instance;
-use crate::linearize::exchange::{place_states, state_derivatives, state_vector};
-
-/// Which interface the host instantiated.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Interface {
-    /// Co-Simulation: fmi2DoStep integrates.
-    CoSimulation,
-    /// Model Exchange: the host integrates ẋ = f(t, x).
-    ModelExchange,
-}
-
-/// What a Model Exchange host has set.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct Exchange {
-    /// fmi2SetTime's time.
-    pub time: f64,
-    /// fmi2SetContinuousStates' x.
-    pub x: Vec<f64>,
-    /// Whether the engine is at (time, x) (false after either changed).
-    pub placed: bool,
-}
+use super::interface::{Exchange, Interface};
+use crate::linearize::{place_states, state_derivatives, state_vector};
 
 impl Instance {
     /// Err unless this is a Model Exchange instance.
@@ -41,7 +22,7 @@ impl Instance {
         let b = self.built.as_mut().ok_or("no engine (not initialized)")?;
         let sel = b.sel.as_ref().map_err(|e| format!("no continuous states: {e}"))?;
         let x = state_vector(&mut b.sim, sel).map_err(|e| format!("the states cannot be evaluated: {e}"))?;
-        self.exchange = super::exchange::Exchange { time: b.sim.time(), x, placed: true };
+        self.exchange = Exchange { time: b.sim.time(), x, placed: true };
         Ok(())
     }
 

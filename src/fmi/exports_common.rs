@@ -7,10 +7,10 @@
 #![allow(clippy::missing_safety_doc)]
 #![allow(non_snake_case)]
 
-use super::exchange::Interface;
 use super::guard::{get, guarded, slice, slice_mut, text, with_stack};
 use super::handle::{create, destroy};
 use super::instance::Instance;
+use super::interface::Interface;
 use super::logger::{Logger, Sink};
 use super::state_machine::{Func, State};
 use super::types::{

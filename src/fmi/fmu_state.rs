@@ -2,8 +2,8 @@
 //! state-machine state, the host's values and the engine state, and their byte form.
 
 use super::config::Config;
-use super::exchange::Exchange;
 use super::guid::checksum;
+use super::interface::Exchange;
 use super::state_machine::State;
 use crate::dae::SimState;
 use crate::dae::bytes::{ByteReader, ByteWriter};

@@ -3,8 +3,8 @@
 //! exports only translate pointers and statuses.
 
 use super::config::Config;
-use super::exchange::{Exchange, Interface};
 use super::fmu_state::FmuState;
+use super::interface::{Exchange, Interface};
 use super::logger::Logger;
 use super::state_handles::StateHandles;
 use super::state_machine::State;

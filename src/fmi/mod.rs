@@ -19,6 +19,7 @@ pub mod guard;
 pub mod guid;
 pub mod handle;
 pub mod instance;
+pub mod interface;
 pub mod logger;
 pub mod resources;
 pub mod state_handles;

@@ -42,15 +42,14 @@ pub fn conditions(sel: &Selection, x: &[f64]) -> StartValues {
 }
 
 /// Put `sim` at time `t` and states `x`: the consistent point, which the states must
-/// still parameterize (else an error naming them and the configuration).
+/// still parameterize (else an error naming them and the configuration, and `sim` stays
+/// where it was).
 pub fn place_states(sim: &mut Simulator, sel: &Selection, t: f64, x: &[f64]) -> Result<(), EngineError> {
     let n = state_count(sim, sel);
     if x.len() != n {
         return Err(EngineError::Numeric(format!("{} state values given, the model has {n}", x.len())));
     }
-    sim.place(t, &conditions(sel, x))?;
-    let ext = sim.ext();
-    check_partition(sim.system(), sel, sim.q(), t, &ext)
+    sim.place(t, &conditions(sel, x), &|sys, q, t, ext| check_partition(sys, sel, q, t, ext))
 }
 
 /// x = [S; W; X] at the engine's current point.

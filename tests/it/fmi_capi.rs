@@ -10,9 +10,13 @@ use mbfmu::fmi::exports_common::*;
 use mbfmu::fmi::exports_cs::*;
 use mbfmu::fmi::exports_me::fmi2SetTime;
 use mbfmu::fmi::exports_state::*;
+use mbfmu::fmi::resources::Interfaces;
 use mbfmu::fmi::state_machine::State;
 use mbfmu::fmi::types::{CO_SIMULATION, Component, LAST_SUCCESSFUL_TIME, MODEL_EXCHANGE, Status};
 use std::ffi::CString;
+
+const CO_SIMULATION_ONLY: Interfaces = Interfaces { model_exchange: false, co_simulation: true };
+const ME_ONLY: Interfaces = Interfaces { model_exchange: true, co_simulation: false };
 
 fn instantiate_with(text: &str, fmu_type: i32, guid_s: &str) -> Component {
     let (name, g, uri) = (c"inst", CString::new(guid_s).unwrap(), resources(text, "capi").1);
@@ -216,7 +220,7 @@ fn every_refused_call_returns_its_status_names_the_function_and_leaves_the_insta
         assert_eq!(fmi2GetInteger(c, nul, 0, &mut i), Status::Ok);
         refused(c, fmi2SetBoolean(c, &0, 1, &b), Status::Error, "fmi2SetBoolean", "unknown value reference 0");
         refused(c, fmi2GetString(c, &0, 1, std::ptr::null_mut()), Status::Error, "fmi2GetString", "value is NULL");
-        refused(c, fmi2SetTime(c, 1.0), Status::Error, "fmi2SetTime", "Model Exchange is not supported");
+        refused(c, fmi2SetTime(c, 1.0), Status::Error, "fmi2SetTime", "not allowed in state StepComplete");
         refused(c, fmi2EnterInitializationMode(c), Status::Error, "fmi2EnterInitializationMode", "StepComplete");
         refused(c, fmi2DoStep(c, 0.5, 0.1, 1), Status::Error, "fmi2DoStep", "is not the current time 0");
         refused(c, fmi2DoStep(c, 0.0, -0.1, 1), Status::Error, "fmi2DoStep", "communicationStepSize -0.1");
@@ -247,9 +251,18 @@ fn every_refused_call_returns_its_status_names_the_function_and_leaves_the_insta
 }
 
 #[test]
-fn instantiation_refuses_model_exchange_a_wrong_guid_and_a_missing_model() {
+fn instantiation_refuses_an_interface_the_fmu_lacks_a_wrong_guid_and_a_missing_model() {
     let text = model_text("pendulum.xml");
-    assert!(instantiate_with(&text, MODEL_EXCHANGE, &guid(&text)).is_null());
+    let g = CString::new(guid(&text)).unwrap();
+    for (kind, lacks, offered) in
+        [(MODEL_EXCHANGE, "Model Exchange", CO_SIMULATION_ONLY), (CO_SIMULATION, "Co-Simulation", ME_ONLY)]
+    {
+        let uri = host::resources_offering(&text, "capi", Some(offered)).1;
+        // SAFETY: valid NUL-terminated strings.
+        let (c, logged) = unsafe { host::instantiate_logged(c"i".as_ptr(), kind, g.as_ptr(), uri.as_ptr(), 0, 1) };
+        assert!(c.is_null(), "{lacks} instantiated");
+        assert!(logged.iter().any(|m| m.contains(lacks)), "{lacks}: {logged:?}");
+    }
     assert!(instantiate_with(&text, CO_SIMULATION, "{00000000-0000-0000-0000-000000000000}").is_null());
     let uri = c"file:///nonexistent/resources";
     let g = CString::new(guid(&text)).unwrap();

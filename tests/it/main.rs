@@ -42,6 +42,7 @@ mod malformed;
 mod memory_valgrind;
 mod modal;
 mod model_description;
+mod model_exchange;
 mod models_parse;
 mod modes;
 mod nonholonomic;

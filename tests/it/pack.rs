@@ -87,7 +87,13 @@ fn pack_writes_the_fmu_zip_and_directory() {
     let names: Vec<&str> = entries.iter().map(|(n, _)| n.as_str()).collect();
     assert_eq!(
         names,
-        ["modelDescription.xml", "binaries/linux64/pendulum.so", "resources/model.xml", "resources/states.txt"]
+        [
+            "modelDescription.xml",
+            "binaries/linux64/pendulum.so",
+            "resources/model.xml",
+            "resources/states.txt",
+            "resources/interfaces.txt"
+        ]
     );
     let model_bytes = std::fs::read(&model).expect("model readable");
     assert_eq!(entries[2].1, model_bytes, "resources/model.xml is the model file, byte for byte");

@@ -9,6 +9,7 @@
 
 use mbfmu::fmi::exports_common::{fmi2FreeInstance, fmi2GetReal, fmi2Instantiate, fmi2SetReal};
 use mbfmu::fmi::exports_cs::{fmi2GetRealStatus, fmi2GetStatus};
+use mbfmu::fmi::resources::Interfaces;
 use mbfmu::fmi::state_machine::{Func, State};
 use mbfmu::fmi::types::{
     CallbackFunctions, Component, ComponentEnvironment, DO_STEP_STATUS, FmiString, LAST_SUCCESSFUL_TIME, LoggerFn,
@@ -223,8 +224,19 @@ pub fn state(c: Component) -> Option<State> {
 /// copied into the resources under the paths the model gives (as `mbfmu pack` does).
 pub fn resources_of(path: &std::path::Path, tag: &str) -> (PathBuf, CString) {
     let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let (top, uri) = resources(&text, tag);
     let model = mbfmu::model::load_file(path).unwrap_or_else(|e| panic!("{e}"));
+    // A model with modal data files has no layout from its text alone: the one of the
+    // file, and the interfaces `mbfmu pack` would offer with it.
+    let layout = mbfmu::linearize::StateLayout::at_start(&model);
+    let interfaces = Interfaces { model_exchange: layout.missing.is_none(), co_simulation: true };
+    let (top, uri) = resources_offering(&text, tag, Some(interfaces));
+    let file = top.join("resources").join(mbfmu::fmi::resources::LAYOUT_FILE);
+    if !file.exists() {
+        let tmp = file.with_extension(format!("{:?}.tmp", std::thread::current().id()));
+        let guid = mbfmu::fmi::guid::guid(&model, &text);
+        std::fs::write(&tmp, layout.to_text(&guid)).unwrap_or_else(|e| panic!("{}: {e}", tmp.display()));
+        std::fs::rename(&tmp, &file).unwrap_or_else(|e| panic!("{}: {e}", file.display()));
+    }
     for flex in model.bodies.iter().filter_map(|b| b.flex.as_ref()) {
         let to = top.join("resources").join(&flex.file);
         if !to.exists() {
@@ -243,9 +255,26 @@ pub fn resources_of(path: &std::path::Path, tag: &str) -> (PathBuf, CString) {
 /// it when done, if wanted) and the resource location's `file://` URI, with the space and
 /// the `%` of the path escaped as a host must.
 pub fn resources(text: &str, tag: &str) -> (PathBuf, CString) {
+    resources_offering(text, tag, None)
+}
+
+/// [`resources`] for an FMU offering `interfaces` (`None`: what `mbfmu pack` offers by
+/// default, Model Exchange and Co-Simulation when the model has states, else
+/// Co-Simulation only).
+pub fn resources_offering(text: &str, tag: &str, interfaces: Option<Interfaces>) -> (PathBuf, CString) {
     // The layout carries the GUID, which names this build of the engine: hashing it with the
     // text keeps a directory left by another build under a reused process id from being read.
-    let layout = mbfmu::pack::layout_file(text, "model.xml").ok().map(|(l, _)| l);
+    let made = mbfmu::pack::layout_file(text, "model.xml").ok();
+    let interfaces = interfaces.unwrap_or(Interfaces {
+        model_exchange: made.as_ref().is_some_and(|(_, missing)| missing.is_none()),
+        co_simulation: true,
+    });
+    let layout = made.map(|(l, _)| l);
+    let tag = format!(
+        "{tag}{}{}",
+        if interfaces.model_exchange { " me" } else { "" },
+        if interfaces.co_simulation { " cs" } else { "" }
+    );
     let id = {
         use std::hash::{Hash, Hasher};
         let mut h = std::collections::hash_map::DefaultHasher::new();
@@ -260,7 +289,10 @@ pub fn resources(text: &str, tag: &str) -> (PathBuf, CString) {
     if !file.exists() {
         // Write then rename: tests running in parallel never read a half-written file.
         let tmp = dir.join(format!("model.{:?}.tmp", std::thread::current().id()));
-        // The layout first: model.xml present means both are.
+        // The layout and the interfaces first: model.xml present means all are.
+        std::fs::write(&tmp, interfaces.to_text()).unwrap_or_else(|e| panic!("{}: {e}", tmp.display()));
+        let to = dir.join(mbfmu::fmi::resources::INTERFACES_FILE);
+        std::fs::rename(&tmp, &to).unwrap_or_else(|e| panic!("{}: {e}", to.display()));
         if let Some(layout) = layout {
             std::fs::write(&tmp, layout).unwrap_or_else(|e| panic!("{}: {e}", tmp.display()));
             let to = dir.join(mbfmu::fmi::resources::LAYOUT_FILE);
