@@ -1,7 +1,9 @@
 //! FMI call-sequence fuzzing (issue 12 item 5): random legal and illegal call orders over
 //! every example model, with bad value references, NaN/Inf/huge values, zero, negative
 //! and huge steps, stale and foreign FMU-state handles, corrupted serialized states, NULL
-//! arrays, directional derivatives of random subsets, freed components. What must hold:
+//! arrays, directional derivatives of random subsets, freed components; Model Exchange
+//! instances with states set near, far, NaN and of the wrong count, derivatives read,
+//! Euler steps completed, time going back. What must hold:
 //! the process survives (a crash ends the test run), no call panics inside (the guard
 //! would answer it, and logs "internal error (panic)"), every call returns, having made at
 //! most `solver.maxSteps` integrator step attempts (counted, behind the C API: the bound
@@ -18,7 +20,8 @@ use mbfmu::fmi::exports_cs::*;
 use mbfmu::fmi::exports_me::*;
 use mbfmu::fmi::exports_state::*;
 use mbfmu::fmi::types::{
-    CO_SIMULATION, Component, DO_STEP_STATUS, FmuStatePtr, LAST_SUCCESSFUL_TIME, Status, TERMINATED,
+    CO_SIMULATION, Component, DO_STEP_STATUS, EventInfo, FmuStatePtr, LAST_SUCCESSFUL_TIME, MODEL_EXCHANGE, Status,
+    TERMINATED,
 };
 use mbfmu::fmi::variables::{Causality, variables};
 use std::collections::BTreeMap;
@@ -76,6 +79,8 @@ struct Model {
     unknowns: Vec<u32>,
     /// `solver.maxSteps`, the FMU's one Integer variable.
     max_steps: Option<u32>,
+    /// Number of continuous states (Model Exchange).
+    nx: usize,
 }
 
 fn models() -> Vec<Model> {
@@ -101,6 +106,7 @@ fn models() -> Vec<Model> {
                 knowns: vr(&|v| v.known.is_some() || v.causality == Causality::Input),
                 unknowns: vr(&|v| v.unknown.is_some() || v.causality == Causality::Output),
                 max_steps,
+                nx: vars.iter().filter(|v| v.known.is_some()).count(),
                 name,
             }
         })
@@ -200,7 +206,13 @@ fn sequence(r: &mut Rng, m: &Model, other: &Model, tally: &mut Tally) {
     let name = c"seq";
     let bad_guid = CString::new("{00000000-0000-0000-0000-000000000000}").unwrap();
     let guid = if r.chance(0.03) { &bad_guid } else { &m.guid };
-    let fmu_type = if r.chance(0.03) { r.pick(&[0, 7, -1]) } else { CO_SIMULATION };
+    let fmu_type = if r.chance(0.03) {
+        r.pick(&[0, 7, -1])
+    } else if r.chance(0.35) {
+        MODEL_EXCHANGE
+    } else {
+        CO_SIMULATION
+    };
     // SAFETY: valid strings, and the host's callbacks with a recording logger (the wrong
     // GUID and type are refused values).
     let c = unsafe { host::instantiate(name.as_ptr(), fmu_type, guid.as_ptr(), m.uri.as_ptr(), 0, 1) };
@@ -239,7 +251,20 @@ fn sequence(r: &mut Rng, m: &Model, other: &Model, tally: &mut Tally) {
         if r.chance(0.9) {
             // SAFETY: a live instance.
             tally.call(c, "fmi2ExitInitializationMode", || unsafe { fmi2ExitInitializationMode(c) });
+            if fmu_type == MODEL_EXCHANGE && r.chance(0.8) {
+                let mut info = EventInfo::default();
+                // SAFETY: a live instance, a writable event info.
+                tally.call(c, "fmi2NewDiscreteStates", || unsafe { fmi2NewDiscreteStates(c, &mut info) });
+                // SAFETY: a live instance.
+                tally.call(c, "fmi2EnterContinuousTimeMode", || unsafe { fmi2EnterContinuousTimeMode(c) });
+            }
         }
+    }
+    // Model Exchange: the host's states and time, moved as an integrator would (mostly).
+    let mut x = vec![0.0; m.nx];
+    if fmu_type == MODEL_EXCHANGE {
+        // SAFETY: nx writable elements.
+        tally.call(c, "fmi2GetContinuousStates", || unsafe { fmi2GetContinuousStates(c, x.as_mut_ptr(), m.nx) });
     }
     let n_calls = 5 + r.below(40);
     for _ in 0..n_calls {
@@ -247,7 +272,7 @@ fn sequence(r: &mut Rng, m: &Model, other: &Model, tally: &mut Tally) {
         // with a count the FMU must refuse; `c` is a live or freed instance (a freed one
         // must be refused, which is part of what is tested).
         unsafe {
-            match r.below(30) {
+            match r.below(if fmu_type == MODEL_EXCHANGE { 40 } else { 30 }) {
                 0 => {
                     let tol = if r.chance(0.7) { 1e-6 } else { r.real() };
                     tally.call(c, "fmi2SetupExperiment", || fmi2SetupExperiment(c, 1, tol, r.real(), 0, 0.0));
@@ -435,6 +460,78 @@ fn sequence(r: &mut Rng, m: &Model, other: &Model, tally: &mut Tally) {
                 27 => {
                     tally.call(c, "fmi2SetTime", || fmi2SetTime(c, r.real()));
                 }
+                30..=32 => {
+                    // A small move (an integrator's stage), a large one, hostile values,
+                    // or a wrong count.
+                    let mut v = x.clone();
+                    match r.below(10) {
+                        0..=5 => v.iter_mut().for_each(|a| *a += 0.01 * r.real().clamp(-2.0, 2.0)),
+                        6 => v.iter_mut().for_each(|a| *a += r.real() * 10.0),
+                        7 => v.iter_mut().for_each(|a| *a = r.real()),
+                        _ => {}
+                    }
+                    let n = if r.chance(0.9) { m.nx } else { r.pick(&[0, m.nx + 1, 1]) };
+                    v.resize(n, 0.0);
+                    let p = if r.chance(0.05) { std::ptr::null() } else { v.as_ptr() };
+                    if tally.call(c, "fmi2SetContinuousStates", || fmi2SetContinuousStates(c, p, n)) == Status::Ok
+                        && n == m.nx
+                    {
+                        x = v;
+                    }
+                }
+                33..=34 => {
+                    let n = if r.chance(0.9) { m.nx } else { m.nx + 1 };
+                    let mut d = vec![f64::NAN; n];
+                    let s = tally.call(c, "fmi2GetDerivatives", || fmi2GetDerivatives(c, d.as_mut_ptr(), n));
+                    tally.finite("fmi2GetDerivatives", s, &d);
+                    if s == Status::Ok && r.chance(0.8) {
+                        // An Euler step with the derivatives.
+                        let h = r.pick(&[1e-3, 1e-2, 0.1]);
+                        time += h;
+                        tally.call(c, "fmi2SetTime", || fmi2SetTime(c, time));
+                        let v: Vec<f64> = x.iter().zip(&d).map(|(a, b)| a + h * b).collect();
+                        if tally.call(c, "fmi2SetContinuousStates", || fmi2SetContinuousStates(c, v.as_ptr(), m.nx))
+                            == Status::Ok
+                        {
+                            x = v;
+                        }
+                        let (mut enter, mut stop) = (0, 0);
+                        tally.call(c, "fmi2CompletedIntegratorStep", || {
+                            fmi2CompletedIntegratorStep(c, 1, &mut enter, &mut stop)
+                        });
+                    }
+                }
+                35 => {
+                    // Time forward, back (a rejected step), or hostile.
+                    let t = match r.below(4) {
+                        0 => time - 0.05,
+                        1 => r.real(),
+                        _ => time + 0.01,
+                    };
+                    if tally.call(c, "fmi2SetTime", || fmi2SetTime(c, t)) == Status::Ok {
+                        time = t;
+                    }
+                }
+                36 => {
+                    let mut v = vec![f64::NAN; m.nx];
+                    let s =
+                        tally.call(c, "fmi2GetContinuousStates", || fmi2GetContinuousStates(c, v.as_mut_ptr(), m.nx));
+                    tally.finite("fmi2GetContinuousStates", s, &v);
+                    let s = tally.call(c, "fmi2GetNominalsOfContinuousStates", || {
+                        fmi2GetNominalsOfContinuousStates(c, v.as_mut_ptr(), m.nx)
+                    });
+                    tally.finite("fmi2GetNominalsOfContinuousStates", s, &v);
+                    let ni = r.pick(&[0, 1]);
+                    tally.call(c, "fmi2GetEventIndicators", || fmi2GetEventIndicators(c, v.as_mut_ptr(), ni));
+                }
+                37 => {
+                    let mut info = EventInfo::default();
+                    match r.below(3) {
+                        0 => tally.call(c, "fmi2EnterEventMode", || fmi2EnterEventMode(c)),
+                        1 => tally.call(c, "fmi2NewDiscreteStates", || fmi2NewDiscreteStates(c, &mut info)),
+                        _ => tally.call(c, "fmi2EnterContinuousTimeMode", || fmi2EnterContinuousTimeMode(c)),
+                    };
+                }
                 28 if r.chance(0.3) => {
                     // Free mid-sequence: every later call must be refused, not crash.
                     host::free(c);
@@ -501,6 +598,10 @@ fn random_fmi_call_sequences_never_crash_hang_panic_or_return_nan_with_ok() {
     assert!(tally.failures.is_empty(), "{} failures:\n{}", tally.failures.len(), tally.failures.join("\n"));
     // The sequences reach the interesting states: steps, derivatives and states succeed.
     for f in ["fmi2DoStep", "fmi2GetDirectionalDerivative", "fmi2SetFMUstate", "fmi2DeSerializeFMUstate"] {
+        assert!(tally.ok_by_function.get(f).copied().unwrap_or(0) >= count / 20, "{f}: {:?}", tally.ok_by_function);
+    }
+    // Model Exchange too: states set, derivatives read, integrator steps completed.
+    for f in ["fmi2SetContinuousStates", "fmi2GetDerivatives", "fmi2CompletedIntegratorStep"] {
         assert!(tally.ok_by_function.get(f).copied().unwrap_or(0) >= count / 20, "{f}: {:?}", tally.ok_by_function);
     }
     assert!(tally.by_status.get("Error").copied().unwrap_or(0) > count / 10, "{:?}", tally.by_status);
