@@ -54,8 +54,12 @@ def test_packed_fmu_validates(model: Path, tmp_path: Path):
 
     md = read_model_description(str(fmu), validate=True)
     assert md.fmiVersion == "2.0"
-    assert md.coSimulation is not None and md.modelExchange is None
+    # The default kind is both interfaces, one shared library (the linearization states are
+    # the Model Exchange states; every example model has them).
+    assert md.coSimulation is not None and md.modelExchange is not None
     identifier = md.coSimulation.modelIdentifier
+    assert md.modelExchange.modelIdentifier == identifier
+    assert md.modelExchange.providesDirectionalDerivative
     # A flexible body's modal data file travels in resources/, under the path the model gives.
     modal = [f"resources/{f}" for f in re.findall(r'modal="([^"]+)"', model.read_text())]
     with zipfile.ZipFile(fmu) as z:
@@ -65,10 +69,12 @@ def test_packed_fmu_validates(model: Path, tmp_path: Path):
                 f"binaries/linux64/{identifier}.so",
                 "resources/model.xml",
                 "resources/states.txt",
+                "resources/interfaces.txt",
                 *modal,
             ]
         )
         assert z.read("resources/model.xml") == model.read_bytes()
+        assert z.read("resources/interfaces.txt").decode().split() == ["ModelExchange", "CoSimulation"]
 
     # The variables are the model's parameters, inputs and outputs, in file order, then the
     # linearization states S, their velocities der(S) and accelerations der(S,2) (in general
@@ -115,3 +121,29 @@ def test_packed_fmu_validates(model: Path, tmp_path: Path):
     # Every unit used is defined (validate_fmu checks it too) and none is unused.
     used = {v.unit for v in md.modelVariables if v.unit is not None}
     assert {u.name for u in md.unitDefinitions} == used
+
+
+@pytest.mark.parametrize("kind", ["me", "cs", "both"])
+def test_pack_kind(kind: str, tmp_path: Path):
+    model = ROOT / "models" / "double_pendulum.xml"
+    fmu = tmp_path / f"{kind}.fmu"
+    r = pack(model, "-o", str(fmu), "--kind", kind)
+    assert r.returncode == 0, r.stderr
+    assert validate_fmu(str(fmu)) == []
+    md = read_model_description(str(fmu), validate=True)
+    assert (md.modelExchange is not None) == (kind != "cs")
+    assert (md.coSimulation is not None) == (kind != "me")
+    names = {"me": ["ModelExchange"], "cs": ["CoSimulation"], "both": ["ModelExchange", "CoSimulation"]}
+    with zipfile.ZipFile(fmu) as z:
+        assert z.read("resources/interfaces.txt").decode().split() == names[kind]
+    # The continuous states are the linearization states: two joint angles and their rates;
+    # each derivative names its state (fmpy resolves <Derivatives> to variables).
+    states = [d.variable.derivative.name for d in md.derivatives]
+    assert states == ["alpha1", "alpha2", "der(alpha1)", "der(alpha2)"]
+
+
+def test_pack_kind_me_fmi3_is_a_usage_error(tmp_path: Path):
+    r = pack(ROOT / "models" / "double_pendulum.xml", "-o", str(tmp_path / "x.fmu"), "--fmi", "3", "--kind", "me")
+    assert r.returncode != 0
+    assert "FMI 3.0 Model Exchange" in r.stderr
+    assert not (tmp_path / "x.fmu").exists()
