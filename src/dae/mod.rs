@@ -2,6 +2,7 @@
 //! initialization (assembly), and the integrator (Radau IIA on the stabilized system).
 
 mod assembly_moves;
+mod branch;
 pub mod bytes;
 pub mod counts;
 pub mod equations;
@@ -22,6 +23,7 @@ mod snapshot;
 pub mod sparse;
 mod start_values;
 
+pub use branch::Accepted;
 pub use error::EngineError;
 pub use observe::BodyState;
 pub use options::SimOptions;

@@ -6,7 +6,7 @@
 
 use super::instance::Instance;
 use super::interface::{Exchange, Interface};
-use crate::linearize::{place_states, state_derivatives, state_vector};
+use crate::linearize::{accept_step, place_states, state_derivatives, state_vector};
 
 impl Instance {
     /// Err unless this is a Model Exchange instance.
@@ -22,7 +22,8 @@ impl Instance {
         let b = self.built.as_mut().ok_or("no engine (not initialized)")?;
         let sel = b.sel.as_ref().map_err(|e| format!("no continuous states: {e}"))?;
         let x = state_vector(&mut b.sim, sel).map_err(|e| format!("the states cannot be evaluated: {e}"))?;
-        self.exchange = Exchange { time: b.sim.time(), x, placed: true };
+        let accepted = Some(b.sim.accepted_point());
+        self.exchange = Exchange { time: b.sim.time(), x, placed: true, accepted };
         Ok(())
     }
 
@@ -128,10 +129,18 @@ impl Instance {
     }
 
     /// fmi2CompletedIntegratorStep: the point of the accepted step is solved (its angle
-    /// branches recorded, its Euler frames re-based), so later points continue from it.
+    /// branches recorded, its Euler frames re-based), so later points continue from it,
+    /// and checked to be the one the motion from the last accepted step continues to
+    /// (else an error: the states went through a fold of their chart on the way).
     pub fn completed_integrator_step(&mut self) -> Result<(), String> {
         self.exchange_only()?;
-        self.place_if_exchange()
+        self.place_if_exchange()?;
+        let Some(b) = self.built.as_mut() else { return Ok(()) };
+        let sel = b.sel.as_ref().map_err(|e| format!("no continuous states: {e}"))?;
+        let e = &mut self.exchange;
+        let next = accept_step(&mut b.sim, sel, &e.x, e.accepted.as_ref()).map_err(|e| e.to_string())?;
+        e.accepted = Some(next);
+        Ok(())
     }
 
     /// Err unless `n` (argument `what`) is the number of continuous states.

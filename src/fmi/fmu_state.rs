@@ -5,8 +5,8 @@ use super::config::Config;
 use super::guid::checksum;
 use super::interface::Exchange;
 use super::state_machine::State;
-use crate::dae::SimState;
 use crate::dae::bytes::{ByteReader, ByteWriter};
+use crate::dae::{Accepted, SimState};
 
 const MAGIC: &[u8; 8] = b"MBFMUF02";
 
@@ -53,6 +53,12 @@ impl FmuState {
         if let Some(e) = &self.exchange {
             w.f64s(&[e.time, if e.placed { 1.0 } else { 0.0 }]);
             w.f64s(&e.x);
+            if let Some(a) = &e.accepted {
+                w.f64s(&[a.t]);
+                w.f64s(&a.q);
+                w.f64s(&a.qdot);
+                w.f64s(&a.frames);
+            }
         }
         let sum = checksum(w.as_slice());
         w.u64(sum);
@@ -87,7 +93,15 @@ impl FmuState {
         } else {
             let th = r.f64s().filter(|h| h.len() == 2).ok_or_else(bad)?;
             let x = r.f64s().ok_or_else(bad)?;
-            Some(Exchange { time: th[0], x, placed: th[1] == 1.0 })
+            let accepted = if r.at_end() {
+                None
+            } else {
+                let t = r.f64s().filter(|t| t.len() == 1).ok_or_else(bad)?[0];
+                let (q, qdot, frames) =
+                    (r.f64s().ok_or_else(bad)?, r.f64s().ok_or_else(bad)?, r.f64s().ok_or_else(bad)?);
+                Some(Accepted { t, q, qdot, frames })
+            };
+            Some(Exchange { time: th[0], x, placed: th[1] == 1.0, accepted })
         };
         if head.len() != 4 || !r.at_end() {
             return Err(bad());

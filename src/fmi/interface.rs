@@ -1,6 +1,8 @@
 //! Which FMI interface an instance serves, and what a Model Exchange host has set there
 //! (the value the host changes, apart from the engine; saved with the FMU state).
 
+use crate::dae::Accepted;
+
 /// Which interface the host instantiated.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Interface {
@@ -19,4 +21,7 @@ pub struct Exchange {
     pub x: Vec<f64>,
     /// Whether the engine is at (time, x) (false after either changed).
     pub placed: bool,
+    /// The engine's point at the last accepted step (fmi2CompletedIntegratorStep, or the
+    /// end of initialization), from which the next accepted step is checked.
+    pub accepted: Option<Accepted>,
 }

@@ -8,7 +8,7 @@ use super::partition::check_partition;
 use super::select::Selection;
 use super::state_values;
 use super::states::VelState;
-use crate::dae::{EngineError, Simulator, StartValue, StartValues};
+use crate::dae::{Accepted, EngineError, Simulator, StartValue, StartValues};
 use crate::mechanics::constraints::VelocityIcKind;
 
 /// Number of ODE states of `sel` on `sim`'s system: s0 + s1 + nx.
@@ -50,6 +50,22 @@ pub fn place_states(sim: &mut Simulator, sel: &Selection, t: f64, x: &[f64]) -> 
         return Err(EngineError::Numeric(format!("{} state values given, the model has {n}", x.len())));
     }
     sim.place(t, &conditions(sel, x), &|sys, q, t, ext| check_partition(sys, sel, q, t, ext))
+}
+
+/// The host accepted a step to the engine's current point, placed at states `x`: Err if
+/// the motion from `prev` (the last accepted point) went through a fold of the states'
+/// chart on the way ([`Simulator::check_branch`]), else the point to check the next
+/// step from.
+pub fn accept_step(
+    sim: &mut Simulator,
+    sel: &Selection,
+    x: &[f64],
+    prev: Option<&Accepted>,
+) -> Result<Accepted, EngineError> {
+    if let Some(prev) = prev {
+        sim.check_branch(prev, &conditions(sel, x))?;
+    }
+    Ok(sim.accepted_point())
 }
 
 /// x = [S; W; X] at the engine's current point.

@@ -29,7 +29,7 @@ pub mod tolerances;
 
 pub use augmented::{Route, linearize, linearize_with};
 pub use candidates::Candidates;
-pub use exchange::{place_states, state_count, state_derivatives, state_vector};
+pub use exchange::{accept_step, place_states, state_count, state_derivatives, state_vector};
 pub use layout::{StateInfo, StateLayout, selection_by_name};
 pub use linearization::Linearization;
 pub use seeded::Seeded;

@@ -3,6 +3,7 @@
 
 use super::constraints::{ConstraintKind, VelocityIc, VelocityIcKind};
 use super::local::LocalCtx;
+use super::measures::StateKind;
 use super::nonholonomic_equations::wheel_contact;
 use crate::ad::Real;
 use crate::model::JointType;
@@ -29,7 +30,19 @@ impl ConstraintKind {
                 let (pc, n, o, _) = wheel_contact(ctx, *m, *radius, *plane);
                 out[0] = (pc - o).dot(&n);
             }
-            ConstraintKind::State { kind, value } => out[0] = kind.eval(ctx) - T::cst(*value),
+            ConstraintKind::State { kind, value } => {
+                let d = kind.eval(ctx) - T::cst(*value);
+                out[0] = match kind {
+                    // A body's 3-1-3 angle reads in (−π, π]: the state's value is met on
+                    // any branch (whole turns off the residual), so a spin state runs
+                    // past ±π without a jump.
+                    StateKind::Angle { .. } => {
+                        let turn = 2.0 * std::f64::consts::PI;
+                        d - T::cst(turn * (d.val() / turn).round())
+                    }
+                    _ => d,
+                };
+            }
         }
     }
 }

@@ -358,6 +358,52 @@ fn states_that_stop_parameterizing_the_mechanism_are_an_error_naming_them_and_th
     free(me.c);
 }
 
+/// fmi2CompletedIntegratorStep at (t, x); its status and, unless Ok, the message.
+fn complete_step_at(me: &Fmu, t: f64, x: &[f64]) -> Result<(), String> {
+    me.set(t, x);
+    let (mut enter, mut terminate) = (1, 1);
+    // SAFETY: writable flags.
+    match unsafe { fmi2CompletedIntegratorStep(me.c, 1, &mut enter, &mut terminate) } {
+        Status::Ok => Ok(()),
+        _ => Err(last_message(me.c)),
+    }
+}
+
+#[test]
+fn a_host_step_through_a_fold_of_the_states_chart_is_an_error_naming_the_states() {
+    // blade_y: the blade turns with the hub, α = w t (w = 10), its CM at (12 cos wt,
+    // 12 sin wt), and its one state is y = 12 sin(wt), ẏ = 120 cos(wt) — a chart of the
+    // blade's angle only on |α| < π/2. The host gives the exact states of that motion.
+    // Before the fold (t = 0.15 → 0.155) the accepted steps are accepted; the step
+    // 0.15 → 0.16 goes through y = 12 at t = π/20: the states at 0.16 (y = 11.9949 < 12,
+    // ẏ < 0) have a configuration on the branch the engine is on (the blade swung back)
+    // and one past the fold (the blade going on), and the step is refused, naming the state
+    // and the step; the instance then still answers at the last accepted point.
+    let path = model_dir().join("blade_y.xml");
+    let me = open(&path, None, MODEL_EXCHANGE, 1e-8);
+    let exact = |t: f64| [12.0 * (10.0 * t).sin(), 120.0 * (10.0 * t).cos()];
+    assert!(me.states().iter().zip(exact(0.0)).all(|(a, b)| (a - b).abs() < 1e-9), "{:?}", me.states());
+    for t in [0.05, 0.1, 0.15, 0.155] {
+        complete_step_at(&me, t, &exact(t)).unwrap_or_else(|m| panic!("t = {t}: {m}"));
+    }
+    let before = me.derivatives();
+    // The step from 0.155 over the fold: refused.
+    let m = complete_step_at(&me, 0.16, &exact(0.16)).expect_err("the fold is refused");
+    assert!(
+        m.starts_with("fmi2CompletedIntegratorStep")
+            && m.contains("between t = 0.155 and t = 0.16")
+            && m.contains("yb = ")
+            && m.contains("do not parameterize"),
+        "{m}"
+    );
+    // The engine answers again at the states it last accepted.
+    me.set(0.155, &exact(0.155));
+    for (a, b) in me.derivatives().iter().zip(&before) {
+        assert!(close(*a, *b, 1e-9), "back at t = 0.155: {a} vs {b}");
+    }
+    free(me.c);
+}
+
 /// A rotor about ground z (Izz = 0.5) driven by T = sqrt(1 - time): ω̇ = 2 sqrt(1 - t),
 /// which stops existing at t = 1.
 const DOOMED: &str = r#"<multibody name="doomed" version="1">

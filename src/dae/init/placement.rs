@@ -16,6 +16,10 @@ use crate::model::SrcPos;
 /// Newton converges in 2–4; more means the states do not determine the positions there.
 const MAX_ITERATIONS: usize = 30;
 
+/// Newton iterations past `limit` towards round-off (each kept only while it halves the
+/// residual; from 1e-12 two reach it).
+const POLISH_ITERATIONS: usize = 3;
+
 /// q with C(q, t) = 0 and every position state at its value in `states`, by Newton from
 /// the `q` given (on success q is the solution; on failure the message names the states
 /// and why, and q is unchanged). `limit`: the largest |C| or |s − S| accepted.
@@ -40,6 +44,11 @@ pub fn place_positions(
     let mut trial = q.to_vec();
     match gauss_newton::solve(sys, &els, &mut trial, t, inputs, limit, MAX_ITERATIONS, lu) {
         Ok(()) => {
+            // Down to round-off: the host differentiates ẋ(x) by differences of states
+            // far smaller than `limit` (CVODE's increments of a zero state are ~1e-15);
+            // positions stopped at `limit` would make ẋ a staircase at that scale and
+            // the host's Jacobian garbage.
+            gauss_newton::polish(sys, &els, &mut trial, t, inputs, POLISH_ITERATIONS, lu);
             q.copy_from_slice(&trial);
             Ok(())
         }
