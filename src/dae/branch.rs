@@ -11,6 +11,7 @@
 
 use super::error::EngineError;
 use super::init;
+use super::init::placement::{listed, size};
 use super::partitioned::PLACEMENT_TOL;
 use super::simulator::Simulator;
 use super::start_values::StartValues;
@@ -58,7 +59,7 @@ impl Simulator {
             return Ok(());
         }
         let mut q: Vec<f64> = prev.q.iter().zip(&prev.qdot).map(|(q, v)| q + h * v).collect();
-        let scale = 1.0 + self.q().iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let scale = size(self.q());
         let inputs = self.dae.inputs_at(t);
         let sys = &self.dae.sys;
         let placed =
@@ -70,14 +71,13 @@ impl Simulator {
         if apart <= SAME_CONFIGURATION * scale {
             return Ok(());
         }
-        let names: Vec<String> = set.positions.iter().map(|s| format!("{} = {}", s.name, s.value)).collect();
         Err(EngineError::Numeric(format!(
             "between t = {} and t = {t} the position states went through a configuration they do not \
              parameterize: at t = {t} the states ({}) hold at two configurations {apart:.3e} apart, the one \
              reached from the last point and the one the motion continues to (a fold of the states' chart: \
              choose <linearization> states that stay independent along the motion)",
             prev.t,
-            names.join(", ")
+            listed(&set.positions)
         )))
     }
 }

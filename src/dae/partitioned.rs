@@ -64,7 +64,7 @@ impl Simulator {
         let inputs = self.dae.inputs_at(t);
         let sys = &self.dae.sys;
         let mut q = self.q().to_vec();
-        let limit = PLACEMENT_TOL * (1.0 + q.iter().fold(0.0f64, |a, v| a.max(v.abs())));
+        let limit = PLACEMENT_TOL * init::placement::size(&q);
         init::place_positions(sys, &set.positions, &mut q, t, &inputs, limit, &mut self.acc_lu)
             .map_err(EngineError::Numeric)?;
         let mut u = self.u().to_vec();

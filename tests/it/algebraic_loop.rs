@@ -8,21 +8,8 @@ use mbfmu::dae::{SimOptions, Simulator};
 use mbfmu::linearize::{linearize, select_states};
 use mbfmu::model::parse::load_str;
 
-const MODEL: &str = r#"<multibody name="pin_friction" version="1">
-  <parameter name="mu" value="0.3"/>
-  <parameter name="r" value="0.05" description="pin radius"/>
-  <gravity value="0 0 -9.81"/>
-  <ground><marker name="pin" position="0 0 0" z_axis="0 1 0" x_axis="1 0 0"/></ground>
-  <body name="rod" mass="1.5" inertia="0.02 0.13 0.13" position="0.5 0 0">
-    <marker name="pin" position="-0.5 0 0" z_axis="0 1 0" x_axis="1 0 0"/>
-  </body>
-  <joint name="hinge" type="revolute" i="rod.pin" j="ground.pin"/>
-  <sforce name="friction" type="rotational" i="rod.pin" j="ground.pin"
-          function="-mu*r*sqrt(fx(hinge)^2 + fz(hinge)^2 + 1e-6)*tanh(wz(rod.pin, ground.pin, ground.pin)/0.05)"/>
-  <output name="angle" function="az(rod.pin, ground.pin)"/>
-  <output name="normal" function="sqrt(fx(hinge)^2 + fz(hinge)^2)"/>
-  <output name="torque" function="ty(friction)"/>
-</multibody>"#;
+/// tests/models/pin_friction.xml (outputs: angle, normal, torque, omega).
+const MODEL: &str = include_str!("../models/pin_friction.xml");
 
 #[test]
 fn pin_friction_loop_dissipates_and_its_torque_follows_the_reaction() {

@@ -17,7 +17,7 @@ import pytest
 from fmpy import read_model_description, simulate_fmu
 from fmpy.fmi2 import FMU2Model, FMU2Slave
 
-from fmu_helpers import MODELS, LogCapture, pack_model
+from fmu_helpers import MODELS, ROOT, LogCapture, pack_model
 
 # Every example whose chosen states parameterize its motion over the first second (blade_y
 # linearizes in the blade's y, which stops doing so a quarter turn in: see the last test).
@@ -197,33 +197,12 @@ def test_non_holonomic_sleigh_follows_its_closed_form(tmp_path):
     np.testing.assert_allclose(res["heading_rate"], math.sqrt(m / J) * c / np.cosh(arg), rtol=0, atol=1e-7)
 
 
-FRICTION = """<multibody name="pin_friction" version="1">
-  <parameter name="mu" value="0.3"/>
-  <parameter name="r" value="0.05" description="pin radius"/>
-  <gravity value="0 0 -9.81"/>
-  <ground><marker name="pin" position="0 0 0" z_axis="0 1 0" x_axis="1 0 0"/></ground>
-  <body name="rod" mass="1.5" inertia="0.02 0.13 0.13" position="0.5 0 0">
-    <marker name="pin" position="-0.5 0 0" z_axis="0 1 0" x_axis="1 0 0"/>
-  </body>
-  <joint name="hinge" type="revolute" i="rod.pin" j="ground.pin"/>
-  <sforce name="friction" type="rotational" i="rod.pin" j="ground.pin"
-          function="-mu*r*sqrt(fx(hinge)^2 + fz(hinge)^2 + 1e-6)*tanh(wz(rod.pin, ground.pin, ground.pin)/0.05)"/>
-  <output name="normal" function="sqrt(fx(hinge)^2 + fz(hinge)^2)"/>
-  <output name="torque" function="ty(friction)"/>
-  <output name="omega" function="wy(rod.cm)"/>
-  <experiment stop="2" step="0.01" tolerance="1e-8"/>
-</multibody>
-"""
-
-
 def test_algebraic_loop_through_a_constraint_force(tmp_path):
     """Pin friction proportional to the pin's reaction (which depends on the acceleration,
     which depends on the friction): at every ME output the torque is -mu r |F| tanh(w/eps)
     of that output's own reaction and rate (1e-9: the loop is solved in fmi2GetDerivatives,
     not lagged), and ME follows CS to 1e-6."""
-    model = tmp_path / "pin_friction.xml"
-    model.write_text(FRICTION)
-    p = pack_model(model, tmp_path)
+    p = pack_model(ROOT / "tests" / "models" / "pin_friction.xml", tmp_path)
     opts = dict(relative_tolerance=1e-10, output_interval=0.01, stop_time=2.0)
     me = simulate_fmu(str(p.fmu), fmi_type="ModelExchange", **opts)
     cs = simulate_fmu(str(p.fmu), fmi_type="CoSimulation", **opts)

@@ -69,8 +69,17 @@ pub fn place_positions(
                     blame(row)
                 ),
             };
-            let set: Vec<String> = states.iter().map(|s| format!("{} = {}", s.name, s.value)).collect();
-            Err(format!("no configuration at t = {t} has the position states ({}): {why}", set.join(", ")))
+            Err(format!("no configuration at t = {t} has the position states ({}): {why}", listed(states)))
         }
     }
+}
+
+/// The states with their values, "name = value, …", as the messages name them.
+pub fn listed(states: &[StartValue<StateKind>]) -> String {
+    states.iter().map(|s| format!("{} = {}", s.name, s.value)).collect::<Vec<_>>().join(", ")
+}
+
+/// 1 + max|q|: the size of a model at q, which position tolerances are relative to.
+pub fn size(q: &[f64]) -> f64 {
+    1.0 + q.iter().fold(0.0f64, |a, v| a.max(v.abs()))
 }

@@ -62,7 +62,7 @@ pub fn assemble_positions(
     tol: f64,
 ) -> Result<Assembly, InitError> {
     let els: Vec<ConstraintEl> = sys.constraints.iter().chain(sys.ic_constraints.iter()).cloned().collect();
-    let scale = 1.0 + q.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    let scale = super::placement::size(q);
     let limit = tol * scale;
     let zeros = vec![0.0; sys.n()];
     // 1. The drawing made consistent; drives left free.
