@@ -222,7 +222,8 @@ class Instance:
         self.fmi3 = is_fmi3(md)
         if self.fmi3 and interface != "CoSimulation":
             raise ArgumentError(
-                f"FMU '{md.modelName}': FMI 3.0 Model Exchange is not supported (FMI 3.0: Co-Simulation only)"
+                f"FMU '{md.modelName}': the mbfmu package drives FMI 3.0 FMUs through Co-Simulation only "
+                "(their Model Exchange interface works in FMI hosts, e.g. fmpy's simulate_fmu)"
             )
         cls = FMU3Slave if self.fmi3 else FMU2Slave if interface == "CoSimulation" else FMU2Model
         info = md.coSimulation if interface == "CoSimulation" else md.modelExchange

@@ -26,8 +26,8 @@ pub struct PackArgs {
     #[arg(long, value_name = "VERSION", default_value = "2", value_parser = ["2", "3"])]
     pub fmi: String,
     /// Interfaces of the FMU: me (Model Exchange: the host integrates the linearization
-    /// states), cs (Co-Simulation: the FMU integrates), or both in one FMU (the default;
-    /// FMI 3.0: Co-Simulation only for now).
+    /// states), cs (Co-Simulation: the FMU integrates), or both in one FMU (the default),
+    /// in either FMI version.
     #[arg(long, value_name = "KIND", default_value = "both", value_parser = ["me", "cs", "both"])]
     pub kind: String,
     /// Start values instead of the file's: the FMU's default (and modelDescription

@@ -6,15 +6,30 @@
 
 use super::instance::Instance;
 use super::interface::{Exchange, Interface};
+use super::state_machine::State;
 use crate::linearize::{accept_step, place_states, state_derivatives, state_vector};
 
 impl Instance {
     /// Err unless this is a Model Exchange instance.
-    fn exchange_only(&self) -> Result<(), String> {
+    pub(super) fn exchange_only(&self) -> Result<(), String> {
         match self.interface {
             Interface::ModelExchange => Ok(()),
             Interface::CoSimulation => Err("a Model Exchange function, and this is a Co-Simulation instance".into()),
         }
+    }
+
+    /// EnterContinuousTimeMode (Model Exchange instances only: an FMI 3 Co-Simulation
+    /// instance in Event Mode goes on to Step Mode).
+    pub fn enter_continuous_time_mode(&mut self) -> Result<(), String> {
+        self.exchange_only()?;
+        self.state = State::ContinuousTimeMode;
+        Ok(())
+    }
+
+    /// fmi3GetNumberOfContinuousStates: the number of linearization states.
+    pub fn continuous_state_count(&self) -> Result<usize, String> {
+        self.exchange_only()?;
+        Ok(self.state_count())
     }
 
     /// At the end of initialization: x and time are the engine's.
@@ -91,11 +106,16 @@ impl Instance {
         Ok(())
     }
 
-    /// fmi2GetDerivatives: ẋ = [Ṡ; Ẇ; Ẋ] at (time, x).
+    /// fmi2GetDerivatives, fmi3GetContinuousStateDerivatives: ẋ = [Ṡ; Ẇ; Ẋ] at (time, x);
+    /// in Initialization Mode (FMI 3) at the point the values set so far assemble.
     pub fn derivatives(&mut self, out: &mut [f64]) -> Result<(), String> {
         self.exchange_only()?;
         self.check_count(out.len(), "nx")?;
-        self.place_if_exchange()?;
+        if self.state == State::InitializationMode {
+            self.simulator()?;
+        } else {
+            self.place_if_exchange()?;
+        }
         let b = self.built.as_mut().ok_or("no engine (not initialized)")?;
         let sel = b.sel.as_ref().map_err(|e| format!("no continuous states: {e}"))?;
         let d = state_derivatives(&mut b.sim, sel).map_err(|e| format!("the derivatives cannot be evaluated: {e}"))?;

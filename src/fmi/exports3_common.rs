@@ -5,7 +5,8 @@
 //! the FMI 2 export's body runs.
 //!
 //! Safety of every export: the host calls it as FMI 3.0 specifies (valid pointers with
-//! the stated lengths, an instance from fmi3InstantiateCoSimulation not yet freed, one
+//! the stated lengths, an instance from fmi3InstantiateCoSimulation or
+//! fmi3InstantiateModelExchange not yet freed, one
 //! thread per instance at a time); NULL pointers are checked and refused, never
 //! dereferenced.
 #![allow(clippy::missing_safety_doc)]
@@ -16,6 +17,7 @@ use super::exports_state as state2;
 use super::guard::{guarded, put, slice, slice_mut, text, with_stack};
 use super::handle::create;
 use super::instance::Instance;
+use super::interface::Interface;
 use super::logger::{Logger, Sink};
 use super::state_machine::{Func, State};
 use super::types::{Component, ComponentEnvironment, FmiString, FmuStatePtr, LogMessageFn, Status, ValueReference};
@@ -45,10 +47,58 @@ pub unsafe extern "C" fn fmi3SetDebugLogging(
     unsafe { fmi2::fmi2SetDebugLogging(c, (loggingOn != 0) as i32, nCategories, categories) }
 }
 
-/// fmi3InstantiateCoSimulation: an instance of the model in `<resourcePath>/model.xml`,
-/// or NULL (with the reason logged). Intermediate updates are not used (the FMU never
-/// returns early); with `eventModeUsed` initialization ends in Event Mode, where nothing
-/// happens (the model has no events).
+/// The instance of `interface` that an FMI 3 instantiation function (`func`, its C name)
+/// asks for, or NULL with the reason logged through `logMessage`.
+///
+/// # Safety
+/// The strings are NULL or NUL-terminated, per FMI.
+#[allow(clippy::too_many_arguments)]
+unsafe fn instantiate(
+    func: &str,
+    interface: Interface,
+    instanceName: FmiString,
+    instantiationToken: FmiString,
+    resourcePath: FmiString,
+    loggingOn: Bool3,
+    eventModeUsed: bool,
+    instanceEnvironment: ComponentEnvironment,
+    logMessage: Option<LogMessageFn>,
+) -> Component {
+    let made = catch_unwind(AssertUnwindSafe(|| {
+        // SAFETY: a NUL-terminated string or NULL per FMI.
+        let name = unsafe { text(instanceName, "instanceName") };
+        let sink = Sink::fmi3(logMessage, instanceEnvironment, name.as_deref().unwrap_or("?"));
+        // Parsing the model (recursive over its expressions) needs the engine's stack.
+        let made = with_stack(|| {
+            let name = name?;
+            let fail = |m: String| format!("instance '{name}': {m}");
+            // SAFETY: NUL-terminated strings or NULL per FMI.
+            let token = unsafe { text(instantiationToken, "instantiationToken") }.map_err(fail)?;
+            // SAFETY: as above.
+            let res = unsafe { text(resourcePath, "resourcePath") }.map_err(fail)?;
+            let dir = PathBuf::from(res);
+            let (model, guid, layout) =
+                super::resources::load_for(&dir, interface, "instantiationToken", &token).map_err(fail)?;
+            let mut inst = Instance::new(model, guid, layout, Logger::new(loggingOn != 0), Standard::Fmi3);
+            inst.interface = interface;
+            inst.event_mode = eventModeUsed;
+            Ok::<_, String>(inst)
+        });
+        match made {
+            Ok(inst) => create(inst, sink),
+            Err(msg) => {
+                sink.emit(Status::Error, &format!("{func}: {msg}"));
+                std::ptr::null_mut()
+            }
+        }
+    }));
+    made.unwrap_or(std::ptr::null_mut())
+}
+
+/// fmi3InstantiateCoSimulation: a Co-Simulation instance of the model in
+/// `<resourcePath>/model.xml`, or NULL (with the reason logged). Intermediate updates are
+/// not used (the FMU never returns early); with `eventModeUsed` initialization ends in
+/// Event Mode, where nothing happens (the model has no events).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi3InstantiateCoSimulation(
     instanceName: FmiString,
@@ -64,32 +114,31 @@ pub unsafe extern "C" fn fmi3InstantiateCoSimulation(
     logMessage: Option<LogMessageFn>,
     _intermediateUpdate: *const c_void,
 ) -> Component {
-    let made = catch_unwind(AssertUnwindSafe(|| {
-        // SAFETY: a NUL-terminated string or NULL per FMI.
-        let name = unsafe { text(instanceName, "instanceName") };
-        let sink = Sink::fmi3(logMessage, instanceEnvironment, name.as_deref().unwrap_or("?"));
-        let made = with_stack(|| {
-            let name = name?;
-            let fail = |m: String| format!("instance '{name}': {m}");
-            // SAFETY: NUL-terminated strings or NULL per FMI.
-            let token = unsafe { text(instantiationToken, "instantiationToken") }.map_err(fail)?;
-            // SAFETY: as above.
-            let res = unsafe { text(resourcePath, "resourcePath") }.map_err(fail)?;
-            let (model, guid, layout) =
-                super::resources::load(&PathBuf::from(res), "instantiationToken", &token).map_err(fail)?;
-            let mut inst = Instance::new(model, guid, layout, Logger::new(loggingOn != 0), Standard::Fmi3);
-            inst.event_mode = eventModeUsed != 0;
-            Ok::<_, String>(inst)
-        });
-        match made {
-            Ok(inst) => create(inst, sink),
-            Err(msg) => {
-                sink.emit(Status::Error, &format!("fmi3InstantiateCoSimulation: {msg}"));
-                std::ptr::null_mut()
-            }
-        }
-    }));
-    made.unwrap_or(std::ptr::null_mut())
+    let (name, token, res, env) = (instanceName, instantiationToken, resourcePath, instanceEnvironment);
+    let func = "fmi3InstantiateCoSimulation";
+    // SAFETY: per the module's contract.
+    unsafe {
+        instantiate(func, Interface::CoSimulation, name, token, res, loggingOn, eventModeUsed != 0, env, logMessage)
+    }
+}
+
+/// fmi3InstantiateModelExchange: a Model Exchange instance of the model in
+/// `<resourcePath>/model.xml` (its continuous states are the linearization states), or
+/// NULL with the reason logged (also when the FMU was packed without Model Exchange).
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fmi3InstantiateModelExchange(
+    instanceName: FmiString,
+    instantiationToken: FmiString,
+    resourcePath: FmiString,
+    _visible: Bool3,
+    loggingOn: Bool3,
+    instanceEnvironment: ComponentEnvironment,
+    logMessage: Option<LogMessageFn>,
+) -> Component {
+    let (name, token, res, env) = (instanceName, instantiationToken, resourcePath, instanceEnvironment);
+    let func = "fmi3InstantiateModelExchange";
+    // SAFETY: per the module's contract.
+    unsafe { instantiate(func, Interface::ModelExchange, name, token, res, loggingOn, false, env, logMessage) }
 }
 
 /// Log `msg` through the host's logMessage (if any) and return NULL: an interface type
@@ -103,22 +152,8 @@ fn refuse_instance(log: Option<LogMessageFn>, env: ComponentEnvironment, name: F
     std::ptr::null_mut()
 }
 
-/// fmi3InstantiateModelExchange: NULL, the FMU is Co-Simulation only.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3InstantiateModelExchange(
-    instanceName: FmiString,
-    _instantiationToken: FmiString,
-    _resourcePath: FmiString,
-    _visible: Bool3,
-    _loggingOn: Bool3,
-    instanceEnvironment: ComponentEnvironment,
-    logMessage: Option<LogMessageFn>,
-) -> Component {
-    let msg = "fmi3InstantiateModelExchange: Model Exchange is not supported (this FMU is Co-Simulation only)";
-    refuse_instance(logMessage, instanceEnvironment, instanceName, msg)
-}
-
-/// fmi3InstantiateScheduledExecution: NULL, the FMU is Co-Simulation only.
+/// fmi3InstantiateScheduledExecution: NULL, the FMU offers Model Exchange and
+/// Co-Simulation only.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi3InstantiateScheduledExecution(
     instanceName: FmiString,
@@ -132,8 +167,8 @@ pub unsafe extern "C" fn fmi3InstantiateScheduledExecution(
     _lockPreemption: *const c_void,
     _unlockPreemption: *const c_void,
 ) -> Component {
-    let msg =
-        "fmi3InstantiateScheduledExecution: Scheduled Execution is not supported (this FMU is Co-Simulation only)";
+    let msg = "fmi3InstantiateScheduledExecution: Scheduled Execution is not supported (this FMU offers Model \
+               Exchange and Co-Simulation)";
     refuse_instance(logMessage, instanceEnvironment, instanceName, msg)
 }
 

@@ -8,15 +8,15 @@
 use super::exports3_common::{Bool3, scalars};
 use super::guard::{guarded, put, slice, slice_mut};
 use super::instance::Step;
-use super::state_machine::{Func, State};
+use super::state_machine::Func;
 use super::types::{Component, Status, ValueReference};
 use libc::size_t;
 
-/// fmi3EnterStepMode: from Event Mode to Step Mode.
+/// fmi3EnterStepMode: from Event Mode to Step Mode (Co-Simulation instances only).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi3EnterStepMode(c: Component) -> Status {
     guarded(c, Func::EnterStepMode, |inst| {
-        inst.state = State::StepComplete;
+        inst.enter_step_mode()?;
         Ok(Status::Ok)
     })
 }

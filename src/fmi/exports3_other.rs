@@ -1,8 +1,8 @@
 //! The FMI 3.0 functions of what this FMU does not have, exported because the standard
 //! requires every function of the interface types: variables of other types (any value
 //! reference is unknown), clocks, structural parameters (Configuration Mode), per-element
-//! dependencies at run time (they are in modelDescription.xml), Model Exchange and
-//! Scheduled Execution. Each returns fmi3Error and says why; none changes the instance.
+//! dependencies at run time (they are in modelDescription.xml) and Scheduled Execution.
+//! Each returns fmi3Error and says why; none changes the instance.
 //!
 //! Safety of every export: as in `exports3_common` (only value-reference arrays are read).
 #![allow(clippy::missing_safety_doc)]
@@ -129,7 +129,6 @@ macro_rules! refused {
 }
 
 const NO_CLOCKS: &str = "the FMU has no clocks";
-const CS_ONLY: &str = "Model Exchange is not supported (this FMU is Co-Simulation only)";
 
 refused! {
     /// fmi3GetClock: no clocks.
@@ -166,24 +165,4 @@ refused! {
     /// fmi3GetVariableDependencies: the dependencies are in modelDescription.xml.
     fmi3GetVariableDependencies(_d: ValueReference, _ed: *mut size_t, _i: *mut ValueReference, _ei: *mut size_t,
         _k: *mut i32, _n: size_t) => "not provided: the dependencies are in modelDescription.xml's <ModelStructure>";
-    /// fmi3EnterContinuousTimeMode: Model Exchange only.
-    fmi3EnterContinuousTimeMode() => CS_ONLY;
-    /// fmi3CompletedIntegratorStep: Model Exchange only.
-    fmi3CompletedIntegratorStep(_n: u8, _e: *mut u8, _t: *mut u8) => CS_ONLY;
-    /// fmi3SetTime: Model Exchange only.
-    fmi3SetTime(_t: f64) => CS_ONLY;
-    /// fmi3SetContinuousStates: Model Exchange only.
-    fmi3SetContinuousStates(_x: *const f64, _n: size_t) => CS_ONLY;
-    /// fmi3GetContinuousStateDerivatives: Model Exchange only.
-    fmi3GetContinuousStateDerivatives(_d: *mut f64, _n: size_t) => CS_ONLY;
-    /// fmi3GetEventIndicators: Model Exchange only.
-    fmi3GetEventIndicators(_z: *mut f64, _n: size_t) => CS_ONLY;
-    /// fmi3GetContinuousStates: Model Exchange only.
-    fmi3GetContinuousStates(_x: *mut f64, _n: size_t) => CS_ONLY;
-    /// fmi3GetNominalsOfContinuousStates: Model Exchange only.
-    fmi3GetNominalsOfContinuousStates(_x: *mut f64, _n: size_t) => CS_ONLY;
-    /// fmi3GetNumberOfEventIndicators: Model Exchange only.
-    fmi3GetNumberOfEventIndicators(_n: *mut size_t) => CS_ONLY;
-    /// fmi3GetNumberOfContinuousStates: Model Exchange only.
-    fmi3GetNumberOfContinuousStates(_n: *mut size_t) => CS_ONLY;
 }

@@ -52,8 +52,9 @@ pub unsafe extern "C" fn fmi2SetDebugLogging(
     })
 }
 
-/// fmi2Instantiate (2.1.5): a Co-Simulation instance of the model in
-/// `<fmuResourceLocation>/model.xml`, or NULL (with the reason logged).
+/// fmi2Instantiate (2.1.5): a Co-Simulation or Model Exchange instance (`fmuType`) of the
+/// model in `<fmuResourceLocation>/model.xml`, or NULL (with the reason logged, also when
+/// the FMU was packed without that interface).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2Instantiate(
     instanceName: FmiString,
@@ -117,21 +118,8 @@ unsafe fn instantiate(
     // SAFETY: per this function's contract.
     let res = unsafe { text(res_p, "fmuResourceLocation") }.map_err(fail)?;
     let dir = file_uri_to_path(&res).map_err(fail)?;
-    let offers = super::resources::read_interfaces(&dir).map_err(fail)?;
-    let loaded = super::resources::load(&dir, "fmuGUID", &given).map_err(fail)?;
-    match fmu_type {
-        MODEL_EXCHANGE if !offers.model_exchange => {
-            Err(fail("this FMU was packed without Model Exchange (mbfmu pack --kind me or both)".into()))
-        }
-        MODEL_EXCHANGE if loaded.2.missing.is_some() => Err(fail(format!(
-            "Model Exchange needs the linearization states, and this model has none: {}",
-            loaded.2.missing.as_deref().unwrap_or("")
-        ))),
-        CO_SIMULATION if !offers.co_simulation => {
-            Err(fail("this FMU was packed without Co-Simulation (mbfmu pack --kind cs or both)".into()))
-        }
-        _ => Ok(loaded),
-    }
+    let interface = if fmu_type == MODEL_EXCHANGE { Interface::ModelExchange } else { Interface::CoSimulation };
+    super::resources::load_for(&dir, interface, "fmuGUID", &given).map_err(fail)
 }
 
 /// fmi2FreeInstance (2.1.5): release the instance and the FMU states it still holds

@@ -34,7 +34,7 @@ pub unsafe extern "C" fn fmi2NewDiscreteStates(c: Component, eventInfo: *mut Eve
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2EnterContinuousTimeMode(c: Component) -> Status {
     guarded(c, Func::EnterContinuousTimeMode, |inst| {
-        inst.state = State::ContinuousTimeMode;
+        inst.enter_continuous_time_mode()?;
         Ok(Status::Ok)
     })
 }

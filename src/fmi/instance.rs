@@ -618,6 +618,16 @@ impl Instance {
         Ok(())
     }
 
+    /// fmi3EnterStepMode (Co-Simulation instances only: a Model Exchange one in Event Mode
+    /// goes on to Continuous-Time Mode).
+    pub fn enter_step_mode(&mut self) -> Result<(), String> {
+        if self.interface == Interface::ModelExchange {
+            return Err("a Co-Simulation function, and this is a Model Exchange instance".into());
+        }
+        self.state = State::StepComplete;
+        Ok(())
+    }
+
     /// fmi2DoStep from `t` over `h`.
     pub fn do_step(&mut self, t: f64, h: f64) -> Result<Step, String> {
         if !(h.is_finite() && h >= 0.0) {

@@ -1,7 +1,7 @@
 //! The FMI layer, what runs inside a host: one thin shell over the engine (handles,
 //! guard, state-machine table, instance, logger) under two tables of exports, FMI 2.0
 //! (`exports_*`: Co-Simulation and Model Exchange) and FMI 3.0 (`exports3_*`:
-//! Co-Simulation). It maps value references, enforces
+//! Co-Simulation and Model Exchange). It maps value references, enforces
 //! the state machine, logs, and calls the engine; it computes nothing itself. The
 //! build-time packer is [`crate::pack`].
 
@@ -9,6 +9,7 @@ pub mod config;
 pub mod exchange;
 pub mod exports3_common;
 pub mod exports3_cs;
+pub mod exports3_me;
 pub mod exports3_other;
 pub mod exports_common;
 pub mod exports_cs;

@@ -5,6 +5,7 @@
 use std::path::Path;
 
 use super::guid::{guid, guid_with};
+use super::interface::Interface;
 use crate::dae::StartValues;
 use crate::linearize::StateLayout;
 use crate::model::Model;
@@ -113,4 +114,30 @@ pub fn load(dir: &Path, what: &str, given: &str) -> Result<(Model, String, State
     }
     let layout = read_layout(dir, &own).map_err(|e| format!("no state layout: {e}"))?;
     Ok((model, own, layout))
+}
+
+/// As [`load`], for an instance of `interface`: an error when the FMU was packed without
+/// that interface, or when Model Exchange is asked of a model without linearization
+/// states (they are its continuous states).
+pub fn load_for(
+    dir: &Path,
+    interface: Interface,
+    what: &str,
+    given: &str,
+) -> Result<(Model, String, StateLayout), String> {
+    let offers = read_interfaces(dir)?;
+    let loaded = load(dir, what, given)?;
+    match interface {
+        Interface::ModelExchange if !offers.model_exchange => {
+            Err("this FMU was packed without Model Exchange (mbfmu pack --kind me or both)".into())
+        }
+        Interface::ModelExchange if loaded.2.missing.is_some() => Err(format!(
+            "Model Exchange needs the linearization states, and this model has none: {}",
+            loaded.2.missing.as_deref().unwrap_or("")
+        )),
+        Interface::CoSimulation if !offers.co_simulation => {
+            Err("this FMU was packed without Co-Simulation (mbfmu pack --kind cs or both)".into())
+        }
+        _ => Ok(loaded),
+    }
 }

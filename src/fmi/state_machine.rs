@@ -1,8 +1,9 @@
 //! The state machines of FMI 2.0 Co-Simulation (4.2.4 State Machine of Calling Sequence
-//! from Master to Slave) and Model Exchange (3.2.3) and FMI 3.0 Co-Simulation (4.3):
-//! the FMI 2 column joins both FMI 2 machines (their states are disjoint after
-//! initialization: a Co-Simulation instance never enters Event or Continuous-Time Mode,
-//! a Model Exchange one never StepComplete). One const table of
+//! from Master to Slave) and Model Exchange (3.2.3) and FMI 3.0 Model Exchange (3.3) and
+//! Co-Simulation (4.3): each column joins both machines of its version (their states
+//! differ after initialization: a Model Exchange instance never reaches StepComplete, a
+//! Co-Simulation one never Continuous-Time Mode; FMI 3 Event Mode, which both know, is
+//! told apart by the instance's interface where a function belongs to one of them). One const table of
 //! each function's C names and the states in which it may be called, a column per FMI
 //! version (where the two differ, the table says so), and one guard every export runs
 //! first.
@@ -33,12 +34,12 @@ pub enum State {
     /// only fmi2FreeInstance is allowed.
     Fatal = 128,
     /// Event Mode: FMI 3 Co-Simulation (after fmi3ExitInitializationMode when the host
-    /// uses event mode, or fmi3EnterEventMode) and FMI 2 Model Exchange (after
-    /// fmi2ExitInitializationMode, or fmi2EnterEventMode): nothing happens there, the
-    /// model has no events.
+    /// uses event mode, or fmi3EnterEventMode) and Model Exchange of both versions (after
+    /// ExitInitializationMode, or EnterEventMode): nothing happens there, the model has
+    /// no events.
     EventMode = 256,
-    /// FMI 2 Model Exchange Continuous-Time Mode: the host sets time and states and reads
-    /// derivatives.
+    /// Model Exchange Continuous-Time Mode (FMI 2 and 3): the host sets time and states
+    /// and reads derivatives.
     ContinuousTimeMode = 512,
 }
 
@@ -178,8 +179,12 @@ pub enum Func {
     GetContinuousStates,
     /// `fmi2GetNominalsOfContinuousStates`.
     GetNominalsOfContinuousStates,
+    /// `fmi3GetNumberOfContinuousStates`.
+    GetNumberOfContinuousStates,
+    /// `fmi3GetNumberOfEventIndicators`.
+    GetNumberOfEventIndicators,
     /// The FMI 3 functions of what this FMU does not have (other variable types, clocks,
-    /// configuration mode, Model Exchange, …): refused in any state with a message naming
+    /// configuration mode, Scheduled Execution, …): refused in any state with a message naming
     /// the function.
     Unsupported,
 }
@@ -210,13 +215,18 @@ const fn rule(
 }
 
 /// States with values to read in FMI 3 (Event Mode too).
-const READABLE3: u32 = READABLE | EVENT;
+const READABLE3: u32 = READABLE | EVENT | CONT;
 /// States in which FMI 3 hosts set values.
 const SETTABLE3: u32 = INST | INIT | DONE | EVENT;
+/// States in which FMI 3 hosts set Float64 values (inputs in Continuous-Time Mode too).
+const SETTABLE3_REAL: u32 = SETTABLE3 | CONT;
+/// FMI 3 Model Exchange states in which the derivatives, states and indicators can be
+/// read.
+const ME_READABLE3: u32 = INIT | EVENT | CONT | TERM;
 
 /// Allowed states per function, in `Func` order: FMI 2 masks follow the FMI 2.0 CS and ME
 /// state machines, FMI 3 masks the FMI 3.0 CS one, as modelica/Reference-FMUs encodes them.
-pub const RULES: [Rule; 45] = [
+pub const RULES: [Rule; 47] = [
     rule(Func::SetDebugLogging, ("fmi2SetDebugLogging", ALIVE), ("fmi3SetDebugLogging", ALIVE), false),
     rule(Func::FreeInstance, ("fmi2FreeInstance", ALIVE | FATAL), ("fmi3FreeInstance", ALIVE | FATAL), false),
     rule(Func::SetupExperiment, ("fmi2SetupExperiment", INST), ("", NONE), false),
@@ -235,7 +245,7 @@ pub const RULES: [Rule; 45] = [
     rule(
         Func::Terminate,
         ("fmi2Terminate", DONE | FAIL | ERR | EVENT | CONT),
-        ("fmi3Terminate", DONE | FAIL | ERR | EVENT),
+        ("fmi3Terminate", DONE | FAIL | ERR | EVENT | CONT),
         false,
     ),
     rule(Func::Reset, ("fmi2Reset", ALIVE), ("fmi3Reset", ALIVE), true),
@@ -243,7 +253,7 @@ pub const RULES: [Rule; 45] = [
     rule(Func::GetInteger, ("fmi2GetInteger", READABLE2), ("fmi3GetInt32", READABLE3), false),
     rule(Func::GetBoolean, ("fmi2GetBoolean", READABLE2), ("fmi3GetBoolean", READABLE3), false),
     rule(Func::GetString, ("fmi2GetString", READABLE2), ("fmi3GetString", READABLE3), false),
-    rule(Func::SetReal, ("fmi2SetReal", SETTABLE2), ("fmi3SetFloat64", SETTABLE3), true),
+    rule(Func::SetReal, ("fmi2SetReal", SETTABLE2), ("fmi3SetFloat64", SETTABLE3_REAL), true),
     rule(Func::SetInteger, ("fmi2SetInteger", INST | INIT | DONE | EVENT), ("fmi3SetInt32", SETTABLE3), false),
     rule(Func::SetBoolean, ("fmi2SetBoolean", INST | INIT | DONE | EVENT), ("fmi3SetBoolean", SETTABLE3), false),
     rule(Func::SetString, ("fmi2SetString", INST | INIT | DONE | EVENT), ("fmi3SetString", SETTABLE3), false),
@@ -261,7 +271,7 @@ pub const RULES: [Rule; 45] = [
     rule(
         Func::GetDirectionalDerivative,
         ("fmi2GetDirectionalDerivative", READABLE2),
-        ("fmi3GetDirectionalDerivative", INIT | DONE | FAIL | TERM | EVENT),
+        ("fmi3GetDirectionalDerivative", INIT | DONE | FAIL | TERM | EVENT | CONT),
         false,
     ),
     rule(Func::SetRealInputDerivatives, ("fmi2SetRealInputDerivatives", INST | INIT | DONE), ("", NONE), true),
@@ -281,26 +291,53 @@ pub const RULES: [Rule; 45] = [
     rule(
         Func::GetAdjointDerivative,
         ("", NONE),
-        ("fmi3GetAdjointDerivative", INIT | DONE | FAIL | TERM | EVENT),
+        ("fmi3GetAdjointDerivative", INIT | DONE | FAIL | TERM | EVENT | CONT),
         false,
     ),
-    rule(Func::EnterEventMode, ("fmi2EnterEventMode", EVENT | CONT), ("fmi3EnterEventMode", DONE), false),
+    rule(Func::EnterEventMode, ("fmi2EnterEventMode", EVENT | CONT), ("fmi3EnterEventMode", DONE | CONT), false),
     rule(Func::EnterStepMode, ("", NONE), ("fmi3EnterStepMode", EVENT), false),
     rule(Func::UpdateDiscreteStates, ("", NONE), ("fmi3UpdateDiscreteStates", EVENT), false),
     rule(Func::NewDiscreteStates, ("fmi2NewDiscreteStates", EVENT), ("", NONE), false),
-    rule(Func::EnterContinuousTimeMode, ("fmi2EnterContinuousTimeMode", EVENT), ("", NONE), false),
-    rule(Func::CompletedIntegratorStep, ("fmi2CompletedIntegratorStep", CONT), ("", NONE), true),
-    rule(Func::SetTime, ("fmi2SetTime", EVENT | CONT), ("", NONE), false),
-    rule(Func::SetContinuousStates, ("fmi2SetContinuousStates", CONT), ("", NONE), false),
-    rule(Func::GetDerivatives, ("fmi2GetDerivatives", EVENT | CONT | TERM | ERR), ("", NONE), true),
-    rule(Func::GetEventIndicators, ("fmi2GetEventIndicators", ME_READABLE), ("", NONE), false),
-    rule(Func::GetContinuousStates, ("fmi2GetContinuousStates", ME_READABLE), ("", NONE), false),
+    rule(
+        Func::EnterContinuousTimeMode,
+        ("fmi2EnterContinuousTimeMode", EVENT),
+        ("fmi3EnterContinuousTimeMode", EVENT),
+        false,
+    ),
+    rule(
+        Func::CompletedIntegratorStep,
+        ("fmi2CompletedIntegratorStep", CONT),
+        ("fmi3CompletedIntegratorStep", CONT),
+        true,
+    ),
+    rule(Func::SetTime, ("fmi2SetTime", EVENT | CONT), ("fmi3SetTime", EVENT | CONT), false),
+    rule(Func::SetContinuousStates, ("fmi2SetContinuousStates", CONT), ("fmi3SetContinuousStates", CONT), false),
+    rule(
+        Func::GetDerivatives,
+        ("fmi2GetDerivatives", EVENT | CONT | TERM | ERR),
+        ("fmi3GetContinuousStateDerivatives", ME_READABLE3),
+        true,
+    ),
+    rule(
+        Func::GetEventIndicators,
+        ("fmi2GetEventIndicators", ME_READABLE),
+        ("fmi3GetEventIndicators", ME_READABLE3),
+        false,
+    ),
+    rule(
+        Func::GetContinuousStates,
+        ("fmi2GetContinuousStates", ME_READABLE),
+        ("fmi3GetContinuousStates", ME_READABLE3),
+        false,
+    ),
     rule(
         Func::GetNominalsOfContinuousStates,
         ("fmi2GetNominalsOfContinuousStates", INST | EVENT | CONT | TERM | ERR),
-        ("", NONE),
+        ("fmi3GetNominalsOfContinuousStates", ME_READABLE3),
         false,
     ),
+    rule(Func::GetNumberOfContinuousStates, ("", NONE), ("fmi3GetNumberOfContinuousStates", ME_READABLE3), false),
+    rule(Func::GetNumberOfEventIndicators, ("", NONE), ("fmi3GetNumberOfEventIndicators", ME_READABLE3), false),
     rule(Func::Unsupported, ("", NONE), ("an FMI 3 function", ALIVE), false),
 ];
 

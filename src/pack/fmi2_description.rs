@@ -22,7 +22,7 @@ use crate::model::Model;
 /// [`describe`].
 pub fn write(model: &Model, model_text: &str) -> String {
     let FmuLinearization { layout, structure, starts } = for_fmu(model);
-    let interfaces = super::Kind::Both.interfaces(Standard::Fmi2, &layout).map_or(super::CO_SIMULATION, |(i, _)| i);
+    let interfaces = super::Kind::Both.interfaces(&layout).map_or(super::CO_SIMULATION, |(i, _)| i);
     describe(model, &guid(model, model_text), &layout, &structure, &starts, interfaces)
 }
 

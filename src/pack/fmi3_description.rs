@@ -1,4 +1,5 @@
-//! `modelDescription.xml` of a model's FMI 3.0 Co-Simulation FMU: the same variables as
+//! `modelDescription.xml` of a model's FMI 3.0 FMU (Model Exchange, Co-Simulation or
+//! both): the same variables as
 //! the FMI 2 FMU ([`crate::fmi::variables`], value references unchanged) as `<Float64>`
 //! and `<Int32>`, plus the independent variable `time` (FMI 3 requires one; last, so it
 //! shifts no other value reference); `<ModelStructure>` names variables by value
@@ -11,6 +12,7 @@ use super::structure::unknowns;
 use super::xml::{attr_line, escape, real, with_state_starts, write_experiment, write_units};
 use crate::fmi::guid::{ENGINE_VERSION, guid, model_identifier};
 use crate::fmi::logger::CATEGORIES;
+use crate::fmi::resources::Interfaces;
 use crate::fmi::variables::{Causality, Standard, Variable, variables};
 use crate::linearize::{FmuLinearization, ModelStructure, StateLayout, StateValues, for_fmu};
 use crate::model::Model;
@@ -19,18 +21,21 @@ use crate::model::Model;
 /// file text is `model_text` (see [`super::fmi2_description::write`]).
 pub fn write(model: &Model, model_text: &str) -> String {
     let FmuLinearization { layout, structure, starts } = for_fmu(model);
-    describe(model, &guid(model, model_text), &layout, &structure, &starts)
+    let interfaces = super::Kind::Both.interfaces(&layout).map_or(super::CO_SIMULATION, |(i, _)| i);
+    describe(model, &guid(model, model_text), &layout, &structure, &starts, interfaces)
 }
 
 /// The modelDescription.xml of the FMI 3.0 FMU of `model` with the instantiation token
 /// `token` (the FMI 2 GUID), the linearization states `layout`, their dependencies
-/// `structure` and start values `starts` (see [`super::fmi2_description::describe`]).
+/// `structure` and start values `starts`, offering the `interfaces` (see
+/// [`super::fmi2_description::describe`]).
 pub fn describe(
     model: &Model,
     token: &str,
     layout: &StateLayout,
     structure: &ModelStructure,
     starts: &StateValues,
+    interfaces: Interfaces,
 ) -> String {
     let vars = with_state_starts(variables(model, layout, Standard::Fmi3), model, layout, starts);
     let mut x = String::new();
@@ -43,22 +48,39 @@ pub fn describe(
     attr_line(&mut x, "generationTool", &format!("mbfmu {ENGINE_VERSION}"));
     x.push_str("  variableNamingConvention=\"structured\">\n");
 
-    x.push_str("  <CoSimulation\n");
     let id = model_identifier(&model.name);
-    for (name, value) in [
-        ("modelIdentifier", id.as_str()),
-        ("canGetAndSetFMUState", "true"),
-        ("canSerializeFMUState", "true"),
-        ("providesDirectionalDerivatives", "true"),
-        ("providesAdjointDerivatives", "true"),
-        ("canHandleVariableCommunicationStepSize", "true"),
-        ("maxOutputDerivativeOrder", "1"),
-        ("hasEventMode", "true"),
-    ] {
-        x.push_str("  ");
-        attr_line(&mut x, name, value);
+    if interfaces.model_exchange {
+        // The fold check of the states' chart runs at each completed integrator step.
+        x.push_str("  <ModelExchange\n");
+        for (name, value) in [
+            ("modelIdentifier", id.as_str()),
+            ("canGetAndSetFMUState", "true"),
+            ("canSerializeFMUState", "true"),
+            ("providesDirectionalDerivatives", "true"),
+            ("providesAdjointDerivatives", "true"),
+        ] {
+            x.push_str("  ");
+            attr_line(&mut x, name, value);
+        }
+        x.push_str("    needsCompletedIntegratorStep=\"true\"/>\n");
     }
-    x.push_str("    canReturnEarlyAfterIntermediateUpdate=\"false\"/>\n");
+    if interfaces.co_simulation {
+        x.push_str("  <CoSimulation\n");
+        for (name, value) in [
+            ("modelIdentifier", id.as_str()),
+            ("canGetAndSetFMUState", "true"),
+            ("canSerializeFMUState", "true"),
+            ("providesDirectionalDerivatives", "true"),
+            ("providesAdjointDerivatives", "true"),
+            ("canHandleVariableCommunicationStepSize", "true"),
+            ("maxOutputDerivativeOrder", "1"),
+            ("hasEventMode", "true"),
+        ] {
+            x.push_str("  ");
+            attr_line(&mut x, name, value);
+        }
+        x.push_str("    canReturnEarlyAfterIntermediateUpdate=\"false\"/>\n");
+    }
 
     write_units(&mut x, &vars);
     x.push_str("  <LogCategories>\n");

@@ -113,26 +113,19 @@ pub enum Kind {
 }
 
 impl Kind {
-    /// The interfaces an FMU of FMI version `standard` with the linearization states
-    /// `layout` offers for this kind, and a warning when `Both` has to drop Model
-    /// Exchange; an error when the kind cannot be had (Model Exchange needs the
-    /// linearization states as its continuous states, and is FMI 2.0 only for now).
-    pub fn interfaces(
-        self,
-        standard: Standard,
-        layout: &StateLayout,
-    ) -> Result<(Interfaces, Option<String>), PackError> {
+    /// The interfaces an FMU with the linearization states `layout` offers for this kind
+    /// (either FMI version), and a warning when `Both` has to drop Model Exchange; an
+    /// error when the kind cannot be had (Model Exchange needs the linearization states
+    /// as its continuous states).
+    pub fn interfaces(self, layout: &StateLayout) -> Result<(Interfaces, Option<String>), PackError> {
         let me = matches!(self, Kind::ModelExchange | Kind::Both);
         let cs = matches!(self, Kind::CoSimulation | Kind::Both);
-        let why_not = match (standard, &layout.missing) {
-            (Standard::Fmi3, _) => Some("FMI 3.0 Model Exchange is not available yet (use --fmi 2)".to_string()),
-            (_, Some(why)) => Some(format!("the model has no linearization states to be its continuous states: {why}")),
-            _ => None,
-        };
+        let why_not = layout
+            .missing
+            .as_ref()
+            .map(|why| format!("the model has no linearization states to be its continuous states: {why}"));
         match (me, why_not) {
             (true, Some(why)) if !cs => Err(PackError::Unsupported(format!("--kind me: {why}"))),
-            // FMI 3: Co-Simulation is what `both` means until its Model Exchange exists.
-            (true, Some(_)) if standard == Standard::Fmi3 => Ok((CO_SIMULATION, None)),
             (true, Some(why)) => Ok((CO_SIMULATION, Some(format!("Co-Simulation only: {why}")))),
             _ => Ok((Interfaces { model_exchange: me, co_simulation: cs }, None)),
         }
@@ -237,12 +230,14 @@ fn contents(model_path: &Path, set: &[(String, f64)], standard: Standard, kind: 
     let lib = library()?;
     let FmuLinearization { layout, structure, starts } = for_fmu(&model);
     let guid = guid_with(&base, text, &start_values);
-    let (interfaces, dropped) = kind.interfaces(standard, &layout)?;
+    let (interfaces, dropped) = kind.interfaces(&layout)?;
     let (xml, platform) = match standard {
         Standard::Fmi2 => {
             (fmi2_description::describe(&model, &guid, &layout, &structure, &starts, interfaces), PLATFORM.to_string())
         }
-        Standard::Fmi3 => (fmi3_description::describe(&model, &guid, &layout, &structure, &starts), platform_tuple()),
+        Standard::Fmi3 => {
+            (fmi3_description::describe(&model, &guid, &layout, &structure, &starts, interfaces), platform_tuple())
+        }
     };
     let warnings = layout
         .missing

@@ -142,8 +142,9 @@ def test_pack_kind(kind: str, tmp_path: Path):
     assert states == ["alpha1", "alpha2", "der(alpha1)", "der(alpha2)"]
 
 
-def test_pack_kind_me_fmi3_is_a_usage_error(tmp_path: Path):
+def test_pack_kind_me_fmi3_offers_model_exchange_only(tmp_path: Path):
     r = pack(ROOT / "models" / "double_pendulum.xml", "-o", str(tmp_path / "x.fmu"), "--fmi", "3", "--kind", "me")
-    assert r.returncode != 0
-    assert "FMI 3.0 Model Exchange" in r.stderr
-    assert not (tmp_path / "x.fmu").exists()
+    assert r.returncode == 0, r.stderr
+    assert validate_fmu(str(tmp_path / "x.fmu")) == []
+    md = read_model_description(str(tmp_path / "x.fmu"), validate=True)
+    assert md.modelExchange is not None and md.coSimulation is None
