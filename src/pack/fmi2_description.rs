@@ -9,7 +9,7 @@ use std::collections::BTreeSet;
 use std::fmt::Write as _;
 
 use super::structure::unknowns;
-use super::xml::{attr_line, escape, real, with_state_starts, write_experiment, write_units};
+use super::xml::{attr_line, empty_element, escape, real, with_state_starts, write_experiment, write_units};
 
 use crate::fmi::guid::{ENGINE_VERSION, guid, model_identifier};
 use crate::fmi::resources::Interfaces;
@@ -52,21 +52,17 @@ pub fn describe(
 
     let id = model_identifier(&model.name);
     if interfaces.model_exchange {
-        x.push_str("  <ModelExchange\n");
-        for (name, value) in [
+        let attrs = [
             ("modelIdentifier", id.as_str()),
             ("canGetAndSetFMUstate", "true"),
             ("canSerializeFMUstate", "true"),
             ("canNotUseMemoryManagementFunctions", "true"),
-        ] {
-            x.push_str("  ");
-            attr_line(&mut x, name, value);
-        }
-        x.push_str("    providesDirectionalDerivative=\"true\"/>\n");
+            ("providesDirectionalDerivative", "true"),
+        ];
+        empty_element(&mut x, "ModelExchange", &attrs);
     }
     if interfaces.co_simulation {
-        x.push_str("  <CoSimulation\n");
-        for (name, value) in [
+        let attrs = [
             ("modelIdentifier", id.as_str()),
             ("canHandleVariableCommunicationStepSize", "true"),
             ("canGetAndSetFMUstate", "true"),
@@ -74,11 +70,9 @@ pub fn describe(
             ("canInterpolateInputs", "true"),
             ("maxOutputDerivativeOrder", "1"),
             ("canNotUseMemoryManagementFunctions", "true"),
-        ] {
-            x.push_str("  ");
-            attr_line(&mut x, name, value);
-        }
-        x.push_str("    providesDirectionalDerivative=\"true\"/>\n");
+            ("providesDirectionalDerivative", "true"),
+        ];
+        empty_element(&mut x, "CoSimulation", &attrs);
     }
 
     write_units(&mut x, &vars);

@@ -9,7 +9,7 @@ use std::collections::BTreeSet;
 use std::fmt::Write as _;
 
 use super::structure::unknowns;
-use super::xml::{attr_line, escape, real, with_state_starts, write_experiment, write_units};
+use super::xml::{attr_line, empty_element, escape, real, with_state_starts, write_experiment, write_units};
 use crate::fmi::guid::{ENGINE_VERSION, guid, model_identifier};
 use crate::fmi::logger::CATEGORIES;
 use crate::fmi::resources::Interfaces;
@@ -51,22 +51,18 @@ pub fn describe(
     let id = model_identifier(&model.name);
     if interfaces.model_exchange {
         // The fold check of the states' chart runs at each completed integrator step.
-        x.push_str("  <ModelExchange\n");
-        for (name, value) in [
+        let attrs = [
             ("modelIdentifier", id.as_str()),
             ("canGetAndSetFMUState", "true"),
             ("canSerializeFMUState", "true"),
             ("providesDirectionalDerivatives", "true"),
             ("providesAdjointDerivatives", "true"),
-        ] {
-            x.push_str("  ");
-            attr_line(&mut x, name, value);
-        }
-        x.push_str("    needsCompletedIntegratorStep=\"true\"/>\n");
+            ("needsCompletedIntegratorStep", "true"),
+        ];
+        empty_element(&mut x, "ModelExchange", &attrs);
     }
     if interfaces.co_simulation {
-        x.push_str("  <CoSimulation\n");
-        for (name, value) in [
+        let attrs = [
             ("modelIdentifier", id.as_str()),
             ("canGetAndSetFMUState", "true"),
             ("canSerializeFMUState", "true"),
@@ -75,11 +71,9 @@ pub fn describe(
             ("canHandleVariableCommunicationStepSize", "true"),
             ("maxOutputDerivativeOrder", "1"),
             ("hasEventMode", "true"),
-        ] {
-            x.push_str("  ");
-            attr_line(&mut x, name, value);
-        }
-        x.push_str("    canReturnEarlyAfterIntermediateUpdate=\"false\"/>\n");
+            ("canReturnEarlyAfterIntermediateUpdate", "false"),
+        ];
+        empty_element(&mut x, "CoSimulation", &attrs);
     }
 
     write_units(&mut x, &vars);

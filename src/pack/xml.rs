@@ -14,6 +14,16 @@ pub(super) fn attr_line(x: &mut String, name: &str, value: &str) {
     let _ = writeln!(x, "  {name}=\"{}\"", escape(value));
 }
 
+/// An empty element `<tag .../>` indented by two, one attribute a line, the last one
+/// closing the tag (the interface elements of both FMI versions).
+pub(super) fn empty_element(x: &mut String, tag: &str, attrs: &[(&str, &str)]) {
+    let _ = write!(x, "  <{tag}");
+    for (name, value) in attrs {
+        let _ = write!(x, "\n    {name}=\"{}\"", escape(value));
+    }
+    x.push_str("/>\n");
+}
+
 /// Escape text for a double-quoted XML attribute value.
 pub(super) fn escape(s: &str) -> String {
     let mut out = String::with_capacity(s.len());
