@@ -49,7 +49,7 @@ pub struct SimulateArgs {
     pub r#static: bool,
     /// At the end of the run (also a failed one), print the integrator's statistics
     /// (step attempts, accepted and rejected steps, Newton iterations, Jacobian
-    /// evaluations, factorizations, symbolic analyses, rhs evaluations; totals and per
+    /// evaluations, factorizations (and those the block LU left to the general one), symbolic analyses, rhs evaluations; totals and per
     /// communication step) and the wall time to stderr.
     #[arg(long)]
     pub stats: bool,
@@ -277,6 +277,7 @@ impl StatsReport {
             ("Newton iterations", s.newton_iterations),
             ("Jacobian evaluations", s.jacobians),
             ("factorizations", s.factorizations),
+            ("  by the general LU", s.general_factorizations),
             ("symbolic analyses", s.symbolic_analyses),
             ("rhs evaluations", s.rhs_evaluations),
         ];

@@ -149,6 +149,41 @@ impl Layout {
     pub fn mu_range(&self) -> Range<usize> {
         self.mu()..self.mu() + self.m
     }
+    /// The groups of unknowns the block LU eliminates together (`dae::block_lu`), one
+    /// id per entry of y: each body's coordinates, velocities and acceleration unknowns
+    /// (modal ones included); each constraint element's λ and μ; each non-holonomic
+    /// element's ν; the user unknowns X, Ẋ, V together.
+    pub fn groups(&self, sys: &System) -> Vec<usize> {
+        let mut g = vec![usize::MAX; self.dim()];
+        let mut next = 0;
+        for b in 0..sys.nb() {
+            for d in sys.body_dofs_iter(b) {
+                g[d] = next;
+                g[self.u() + d] = next;
+                if let Some(r) = self.acc_row(&sys.acc_bodies, d) {
+                    g[r] = next;
+                }
+            }
+            next += 1;
+        }
+        for c in sys.constraints.iter().filter(|c| c.row + c.neq <= self.m) {
+            for r in c.row..c.row + c.neq {
+                g[self.lam() + r] = next;
+                g[self.mu() + r] = next;
+            }
+            next += 1;
+        }
+        for e in sys.nonholonomic.iter().filter(|e| e.row + e.neq <= self.mn) {
+            for r in e.row..e.row + e.neq {
+                g[self.nu() + r] = next;
+            }
+            next += 1;
+        }
+        for v in g.iter_mut().filter(|v| **v == usize::MAX) {
+            *v = next;
+        }
+        g
+    }
     /// What entry `i` of y is.
     pub fn slot(&self, i: usize) -> Slot {
         if i < self.u() {

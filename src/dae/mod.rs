@@ -2,12 +2,14 @@
 //! initialization (assembly), and the integrator (Radau IIA on the stabilized system).
 
 mod assembly_moves;
+pub mod block_lu;
 mod branch;
 pub mod bytes;
 pub mod counts;
 pub mod equations;
 mod error;
 pub mod init;
+mod iteration_lu;
 pub mod jacobian;
 pub mod layout;
 mod observe;

@@ -54,6 +54,9 @@ impl DaeProblem for MultibodyDae {
         let a0 = self.lay.acc();
         (0..self.lay.dim()).map(|i| if i < a0 { 0 } else { 2 }).collect()
     }
+    fn groups(&self) -> Vec<usize> {
+        self.lay.groups(&self.sys)
+    }
     fn accepted(&mut self, t: f64, y: &mut [f64]) -> bool {
         let (qs, us) = (self.lay.q_range(), self.lay.u_range());
         let changed = self.sys.rebase_frames(&mut y[qs.clone()]);

@@ -5,8 +5,9 @@
 //! [[α/h M − J, β/h M], [−β/h M, α/h M − J]] sparse LU; embedded error estimate and
 //! step-size control after Hairer & Wanner's RADAU5 (Solving ODEs II, IV.8).
 
+use super::iteration_lu::IterationLu;
 use super::radau_tableau::Tableau;
-use super::sparse::{SparseLu, Triplets};
+use super::sparse::Triplets;
 use faer::c64;
 use faer::sparse::Pair;
 
@@ -25,6 +26,12 @@ pub trait DaeProblem {
     /// Called after each accepted step; returns true if it changed coordinates of y
     /// (e.g. re-based Euler angles), which invalidates extrapolation and the Jacobian.
     fn accepted(&mut self, t: f64, y: &mut [f64]) -> bool;
+    /// Per component: the group of unknowns it belongs to, for the block LU of the
+    /// iteration matrices (`dae::block_lu`); empty (the default): no groups, the general
+    /// sparse LU.
+    fn groups(&self) -> Vec<usize> {
+        Vec::new()
+    }
 }
 
 /// Integrator statistics.
@@ -48,6 +55,9 @@ pub struct Stats {
     pub rhs_evaluations: usize,
     /// Symbolic sparse-LU analyses: one per matrix while the sparsity pattern is unchanged.
     pub symbolic_analyses: usize,
+    /// Factorizations (of the counted ones) the block LU along the mechanism's graph
+    /// refused, so that the general sparse LU took them (`dae::iteration_lu`).
+    pub general_factorizations: usize,
 }
 
 /// Buffers of one step attempt, kept between steps so that a step allocates nothing.
@@ -112,8 +122,10 @@ pub struct Radau {
     e_idx: Vec<Pair<usize, usize>>,
     e1_vals: Vec<f64>,
     e2_vals: Vec<c64>,
-    lu1: SparseLu<f64>,
-    lu2: SparseLu<c64>,
+    /// Groups of unknowns for the block LU ([`DaeProblem::groups`]).
+    groups: Vec<usize>,
+    lu1: IterationLu<f64>,
+    lu2: IterationLu<c64>,
     work: Work,
     h_fact: f64,
     cont: Option<[Vec<f64>; 3]>,
@@ -185,8 +197,9 @@ impl Radau {
             e_idx: Vec::new(),
             e1_vals: Vec::new(),
             e2_vals: Vec::new(),
-            lu1: SparseLu::default(),
-            lu2: SparseLu::default(),
+            groups: p.groups(),
+            lu1: IterationLu::default(),
+            lu2: IterationLu::default(),
             work: Work::default(),
             h_fact: f64::NAN,
             cont: None,
@@ -365,11 +378,12 @@ impl Radau {
         self.e2_vals.extend(self.jac.vals.iter().map(|v| c64::new(-v, 0.0)));
         self.e2_vals.extend(self.mass.vals.iter().map(|v| c64::new(tb.alpha / h * v, -tb.beta / h * v)));
         self.h_fact = f64::NAN;
-        self.lu1.factor_values(n, &self.e_idx, &self.e1_vals)?;
-        self.lu2.factor_values(n, &self.e_idx, &self.e2_vals)?;
+        self.lu1.factor(n, &self.e_idx, &self.e1_vals, &self.groups)?;
+        self.lu2.factor(n, &self.e_idx, &self.e2_vals, &self.groups)?;
         self.h_fact = h;
         self.stats.factorizations += 1;
-        self.stats.symbolic_analyses = self.lu1.analyses + self.lu2.analyses;
+        self.stats.general_factorizations += usize::from(!self.lu1.on_block() || !self.lu2.on_block());
+        self.stats.symbolic_analyses = self.lu1.analyses() + self.lu2.analyses();
         Ok(())
     }
 

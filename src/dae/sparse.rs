@@ -46,11 +46,26 @@ impl Triplets {
 const SOLVE_BLOCK: usize = 16;
 
 /// A scalar the LU factors: f64, or c64 for the complex-pair block of the integrator.
-pub trait LuScalar: ComplexField + Copy + std::ops::AddAssign {
+pub trait LuScalar:
+    ComplexField
+    + Copy
+    + std::ops::AddAssign
+    + std::ops::SubAssign
+    + std::ops::MulAssign
+    + std::ops::Sub<Output = Self>
+    + std::ops::Mul<Output = Self>
+    + std::ops::Div<Output = Self>
+{
     /// Whether the value is finite.
     fn finite(&self) -> bool;
     /// Zero.
     fn zero() -> Self;
+    /// One.
+    fn one() -> Self;
+    /// |re| + |im|: the size pivoting compares (LAPACK's cabs1).
+    fn magnitude(&self) -> f64;
+    /// Whether the value is exactly zero (a product the elimination may skip).
+    fn is_zero(&self) -> bool;
 }
 
 impl LuScalar for f64 {
@@ -60,6 +75,15 @@ impl LuScalar for f64 {
     fn zero() -> Self {
         0.0
     }
+    fn one() -> Self {
+        1.0
+    }
+    fn magnitude(&self) -> f64 {
+        self.abs()
+    }
+    fn is_zero(&self) -> bool {
+        *self == 0.0
+    }
 }
 
 impl LuScalar for c64 {
@@ -68,6 +92,15 @@ impl LuScalar for c64 {
     }
     fn zero() -> Self {
         c64::new(0.0, 0.0)
+    }
+    fn one() -> Self {
+        c64::new(1.0, 0.0)
+    }
+    fn magnitude(&self) -> f64 {
+        self.re.abs() + self.im.abs()
+    }
+    fn is_zero(&self) -> bool {
+        self.re == 0.0 && self.im == 0.0
     }
 }
 

@@ -44,13 +44,14 @@ impl Report {
     }
 }
 
-const LABELS: [&str; 8] = [
+const LABELS: [&str; 9] = [
     "steps attempted",
     "accepted steps",
     "rejected steps",
     "Newton iterations",
     "Jacobian evaluations",
     "factorizations",
+    "by the general LU",
     "symbolic analyses",
     "rhs evaluations",
 ];
@@ -84,6 +85,7 @@ fn simulate_stats_prints_consistent_counts_equal_to_the_engines() {
     assert!(r.total("rhs evaluations") >= 3 * newton, "each Newton iteration evaluates f at 3 stages: {err}");
     assert!(r.total("Jacobian evaluations") >= 1 && r.total("factorizations") >= 1, "{err}");
     assert!(r.total("symbolic analyses") >= 1, "{err}");
+    assert!(r.total("by the general LU") <= r.total("factorizations"), "{err}");
     assert!(r.total("symbolic analyses") <= 2 * r.total("factorizations"), "two matrices per factorization: {err}");
     assert!(r.wall >= 0.0 && r.wall.is_finite(), "{err}");
 
@@ -101,6 +103,7 @@ fn simulate_stats_prints_consistent_counts_equal_to_the_engines() {
         s.newton_iterations,
         s.jacobians,
         s.factorizations,
+        s.general_factorizations,
         s.symbolic_analyses,
         s.rhs_evaluations,
     ];

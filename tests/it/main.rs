@@ -15,6 +15,7 @@ mod architecture;
 mod assembly;
 mod assembly_branches;
 mod bicycle_benchmark;
+mod block_lu;
 mod bounded_step;
 mod bushing;
 mod cli;

@@ -1,0 +1,568 @@
+//! Block LU of the integrator's iteration matrices along the mechanism's graph.
+//!
+//! The unknowns come in groups the DAE names (a body's q, u and accelerations; a
+//! constraint element's λ and μ; …). The groups are eliminated in a minimum-degree order
+//! of the group graph in which a group whose rows have no diagonal entries (the
+//! multipliers) waits until one of its neighbours is gone, so that its diagonal block is
+//! the Schur complement −C D⁻¹ Cᵀ of an eliminated body. On a tree of bodies (a chain,
+//! a vehicle's suspensions) nothing fills in and the work is linear in the number of
+//! bodies with dense kernels of the bodies' size: the order of Baraff's linear-time
+//! Lagrange-multiplier method, here for any matrix with this pattern. Partial pivoting
+//! works inside each diagonal block only; a pivot below [`PIVOT_TOL`] times the largest entry
+//! of its column fails the factorization, and the caller falls back to the general
+//! sparse LU with row pivoting ([`super::sparse::SparseLu`]).
+
+use super::sparse::LuScalar;
+use faer::sparse::Pair;
+use std::collections::{BTreeSet, HashMap};
+
+/// A pivot smaller than this times the largest entry of its column (in the diagonal block,
+/// as eliminated so far) fails the
+/// block factorization (the general LU with row pivoting then takes the matrix).
+pub const PIVOT_TOL: f64 = 1e-12;
+
+/// The symbolic part: groups, elimination order, where each block lives.
+struct Symbolic {
+    n: usize,
+    pattern: Vec<Pair<usize, usize>>,
+    groups: Vec<usize>,
+    /// Group g's unknowns (indices into y) are `vars[start[g]..start[g + 1]]`; its
+    /// position in the block-ordered work vector is `start[g]`.
+    start: Vec<usize>,
+    vars: Vec<usize>,
+    /// Per pattern entry: its place in the arena (duplicates share one).
+    slot: Vec<usize>,
+    /// The eliminations, in order.
+    steps: Vec<Step>,
+    /// Arena offsets of the blocks each step reads and writes (see [`Step`]).
+    offs: Vec<usize>,
+    /// The groups still present at each step, concatenated (see [`Step`]).
+    later: Vec<usize>,
+    arena: usize,
+}
+
+/// One group's elimination: its diagonal block at `diag`; its neighbours not yet
+/// eliminated are `later[l0..l0 + nl]`; `offs[o0..]` holds, for each neighbour j, the
+/// block (k, j), then for each j the block (j, k), then for each pair (i, j) of
+/// neighbours the block (i, j) (row-major over i, j).
+struct Step {
+    k: usize,
+    diag: usize,
+    l0: usize,
+    nl: usize,
+    o0: usize,
+}
+
+/// A sparse LU by dense blocks of unknown groups (module docs). Reuses its symbolic
+/// analysis while the pattern and the groups are unchanged; a refactorization
+/// allocates nothing.
+pub struct BlockLu<T: LuScalar> {
+    sym: Option<Symbolic>,
+    arena: Vec<T>,
+    /// Row interchanges of each diagonal block (LAPACK's ipiv, local indices), by `start`.
+    piv: Vec<usize>,
+    /// Scratch: a step's diagonal block, its U row blocks and L column blocks, the work
+    /// vector of a solve.
+    d: Vec<T>,
+    u: Vec<T>,
+    l: Vec<T>,
+    w: Vec<T>,
+    factored: bool,
+    /// Number of symbolic analyses performed.
+    pub analyses: usize,
+}
+
+impl<T: LuScalar> Default for BlockLu<T> {
+    fn default() -> Self {
+        BlockLu {
+            sym: None,
+            arena: Vec::new(),
+            piv: Vec::new(),
+            d: Vec::new(),
+            u: Vec::new(),
+            l: Vec::new(),
+            w: Vec::new(),
+            factored: false,
+            analyses: 0,
+        }
+    }
+}
+
+impl<T: LuScalar> BlockLu<T> {
+    /// Factor the n×n matrix with entries `vals` at `idx` (duplicates summed), unknown i
+    /// in group `groups[i]`. Fails (and holds no factorization) when a pivot is too small
+    /// for elimination without pivoting between groups, or a value is not finite.
+    pub fn factor(&mut self, n: usize, idx: &[Pair<usize, usize>], vals: &[T], groups: &[usize]) -> Result<(), String> {
+        self.factored = false;
+        let reuse = matches!(&self.sym, Some(s) if s.n == n && s.pattern == idx && s.groups == groups);
+        if !reuse {
+            let s = analyze(n, idx, groups)?;
+            self.arena = vec![<T as LuScalar>::zero(); s.arena];
+            self.piv = vec![0; n];
+            let widest = (0..s.start.len() - 1).map(|g| s.start[g + 1] - s.start[g]).max().unwrap_or(0);
+            let wide = s.steps.iter().map(|st| (0..st.nl).map(|j| size(&s, s.later[st.l0 + j])).sum::<usize>());
+            let wide = wide.max().unwrap_or(0);
+            self.d = vec![<T as LuScalar>::zero(); widest * widest];
+            self.u = vec![<T as LuScalar>::zero(); widest * wide];
+            self.l = vec![<T as LuScalar>::zero(); widest * wide];
+            self.w = vec![<T as LuScalar>::zero(); n];
+            self.sym = Some(s);
+            self.analyses += 1;
+        }
+        let s = self.sym.as_ref().expect("symbolic analysis present");
+        if vals.iter().any(|v| !v.finite()) {
+            return Err("matrix has non-finite entries".into());
+        }
+        self.arena.iter_mut().for_each(|v| *v = <T as LuScalar>::zero());
+        for (&k, &v) in s.slot.iter().zip(vals) {
+            self.arena[k] += v;
+        }
+        for (si, st) in s.steps.iter().enumerate() {
+            eliminate(s, st, &mut self.arena, &mut self.piv, &mut self.d, &mut self.u, &mut self.l).map_err(|e| {
+                format!(
+                    "step {si} group {} size {} later {:?}: {e}",
+                    st.k,
+                    size(s, st.k),
+                    &s.later[st.l0..st.l0 + st.nl]
+                )
+            })?;
+        }
+        self.factored = true;
+        Ok(())
+    }
+
+    /// Solve A x = b in place; false if there is no factorization or the result is not
+    /// finite.
+    pub fn solve(&mut self, b: &mut [T]) -> bool {
+        let Some(s) = self.sym.as_ref().filter(|_| self.factored) else { return false };
+        let (a, w) = (&self.arena, &mut self.w);
+        for (p, &v) in s.vars.iter().enumerate() {
+            w[p] = b[v];
+        }
+        // Forward: w_k ← L_kk⁻¹ P_k w_k, then w_i −= L_ik w_k for the later groups.
+        for st in &s.steps {
+            let (k0, sk) = (s.start[st.k], size(s, st.k));
+            let dg = &a[st.diag..st.diag + sk * sk];
+            for (c, &p) in self.piv[k0..k0 + sk].iter().enumerate() {
+                w.swap(k0 + c, k0 + p);
+            }
+            unit_lower_solve(dg, sk, &mut w[k0..k0 + sk]);
+            for j in 0..st.nl {
+                let i = s.later[st.l0 + j];
+                let (i0, si) = (s.start[i], size(s, i));
+                let off = s.offs[st.o0 + st.nl + j];
+                for c in 0..sk {
+                    let x = w[k0 + c];
+                    if x.is_zero() {
+                        continue;
+                    }
+                    axpy(&mut w[i0..i0 + si], &a[off + c * si..off + (c + 1) * si], x);
+                }
+            }
+        }
+        // Backward: w_k ← U_kk⁻¹ (w_k − Σ_j U_kj w_j).
+        for st in s.steps.iter().rev() {
+            let (k0, sk) = (s.start[st.k], size(s, st.k));
+            for j in 0..st.nl {
+                let g = s.later[st.l0 + j];
+                let (g0, sg) = (s.start[g], size(s, g));
+                let off = s.offs[st.o0 + j];
+                for c in 0..sg {
+                    let x = w[g0 + c];
+                    if x.is_zero() {
+                        continue;
+                    }
+                    axpy(&mut w[k0..k0 + sk], &a[off + c * sk..off + (c + 1) * sk], x);
+                }
+            }
+            let dg = &a[st.diag..st.diag + sk * sk];
+            let wk = &mut w[k0..k0 + sk];
+            for c in (0..sk).rev() {
+                let x = wk[c] / dg[c + c * sk];
+                wk[c] = x;
+                axpy(&mut wk[..c], &dg[c * sk..c * sk + c], x);
+            }
+        }
+        for (p, &v) in s.vars.iter().enumerate() {
+            b[v] = w[p];
+        }
+        b.iter().all(|v| v.finite())
+    }
+}
+
+fn size(s: &Symbolic, g: usize) -> usize {
+    s.start[g + 1] - s.start[g]
+}
+
+/// Eliminate one group: LU of its diagonal block (partial pivoting inside it), its U row
+/// blocks L_kk⁻¹ P A_kj, its L column blocks A_ik U_kk⁻¹, and the Schur updates
+/// A_ij −= L_ik U_kj of the groups still present.
+fn eliminate<T: LuScalar>(
+    s: &Symbolic,
+    st: &Step,
+    a: &mut [T],
+    piv: &mut [usize],
+    d: &mut [T],
+    u: &mut [T],
+    l: &mut [T],
+) -> Result<(), String> {
+    let (k0, sk) = (s.start[st.k], size(s, st.k));
+    let d = &mut d[..sk * sk];
+    d.copy_from_slice(&a[st.diag..st.diag + sk * sk]);
+    let piv = &mut piv[k0..k0 + sk];
+    lu_in_place(d, sk, piv)?;
+    a[st.diag..st.diag + sk * sk].copy_from_slice(d);
+    let nbr = &s.later[st.l0..st.l0 + st.nl];
+    let offs = &s.offs[st.o0..];
+    // U_kj = L_kk⁻¹ P A_kj (sk × sj), side by side in `u`; L_ik = A_ik U_kk⁻¹ (si × sk)
+    // one after the other in `l`.
+    let mut ucol = 0;
+    let mut lpos = 0;
+    for (j, &g) in nbr.iter().enumerate() {
+        let sg = size(s, g);
+        let (okj, ojk) = (offs[j], offs[st.nl + j]);
+        for c in 0..sg {
+            let col = &mut a[okj + c * sk..okj + (c + 1) * sk];
+            for (r, &p) in piv.iter().enumerate() {
+                col.swap(r, p);
+            }
+            unit_lower_solve(d, sk, col);
+            u[(ucol + c) * sk..(ucol + c + 1) * sk].copy_from_slice(col);
+        }
+        ucol += sg;
+        let blk = &mut a[ojk..ojk + sg * sk];
+        for c in 0..sk {
+            let (left, right) = blk.split_at_mut(c * sg);
+            let out = &mut right[..sg];
+            for p in 0..c {
+                let upc = d[p + c * sk];
+                if !upc.is_zero() {
+                    axpy(out, &left[p * sg..(p + 1) * sg], upc);
+                }
+            }
+            let inv = <T as LuScalar>::one() / d[c + c * sk];
+            out.iter_mut().for_each(|v| *v *= inv);
+        }
+        l[lpos..lpos + sg * sk].copy_from_slice(blk);
+        lpos += sg * sk;
+    }
+    // A_ij −= L_ik U_kj.
+    let mut lpos = 0;
+    for (i, &gi) in nbr.iter().enumerate() {
+        let si = size(s, gi);
+        let li = &l[lpos..lpos + si * sk];
+        let mut ucol = 0;
+        for (j, &gj) in nbr.iter().enumerate() {
+            let sj = size(s, gj);
+            let oij = offs[2 * st.nl + i * st.nl + j];
+            let blk = &mut a[oij..oij + si * sj];
+            for (c, out) in blk.chunks_exact_mut(si).enumerate() {
+                let ucolv = &u[(ucol + c) * sk..(ucol + c + 1) * sk];
+                for (&x, lcol) in ucolv.iter().zip(li.chunks_exact(si)) {
+                    if !x.is_zero() {
+                        axpy(out, lcol, x);
+                    }
+                }
+            }
+            ucol += sj;
+        }
+        lpos += si * sk;
+    }
+    Ok(())
+}
+
+/// y −= x·a.
+#[inline]
+fn axpy<T: LuScalar>(y: &mut [T], x: &[T], a: T) {
+    for (o, &v) in y.iter_mut().zip(x) {
+        *o -= v * a;
+    }
+}
+
+/// x ← L⁻¹ x for the unit lower triangle of the column-major s×s `d`.
+#[inline]
+fn unit_lower_solve<T: LuScalar>(d: &[T], s: usize, x: &mut [T]) {
+    for c in 0..s {
+        let v = x[c];
+        if !v.is_zero() {
+            axpy(&mut x[c + 1..s], &d[c * s + c + 1..(c + 1) * s], v);
+        }
+    }
+}
+
+/// Dense LU with partial pivoting of the column-major s×s matrix `d` in place
+/// (unit L below, U on and above the diagonal); `piv[c]` is the row swapped with row c.
+fn lu_in_place<T: LuScalar>(d: &mut [T], s: usize, piv: &mut [usize]) -> Result<(), String> {
+    for c in 0..s {
+        // The column's largest entry before elimination: a pivot is small against its
+        // own column (a flexible body's stiffness rows are 10¹³ times its rigid inertia).
+        let big = d[c * s..(c + 1) * s].iter().fold(0.0f64, |m, v| m.max(v.magnitude()));
+        let (mut p, mut best) = (c, d[c + c * s].magnitude());
+        for r in c + 1..s {
+            let v = d[r + c * s].magnitude();
+            if v > best {
+                (p, best) = (r, v);
+            }
+        }
+        if best <= PIVOT_TOL * big || best == 0.0 {
+            return Err(format!("pivot {best:e} below {PIVOT_TOL:e} of its column's largest entry {big:e}"));
+        }
+        piv[c] = p;
+        if p != c {
+            for cc in 0..s {
+                d.swap(c + cc * s, p + cc * s);
+            }
+        }
+        let inv = <T as LuScalar>::one() / d[c + c * s];
+        d[c * s + c + 1..(c + 1) * s].iter_mut().for_each(|v| *v *= inv);
+        let (left, right) = d.split_at_mut((c + 1) * s);
+        let lcol = &left[c * s + c + 1..];
+        for col in right.chunks_exact_mut(s) {
+            let x = col[c];
+            if !x.is_zero() {
+                axpy(&mut col[c + 1..], lcol, x);
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The symbolic analysis: groups, their graph, the elimination order, the blocks of the
+/// filled pattern and the arena places of the entries.
+fn analyze(n: usize, idx: &[Pair<usize, usize>], groups: &[usize]) -> Result<Symbolic, String> {
+    if groups.len() != n {
+        return Err(format!("{} groups for {n} unknowns", groups.len()));
+    }
+    let ng = groups.iter().max().map_or(0, |g| g + 1);
+    let mut start = vec![0usize; ng + 1];
+    for &g in groups {
+        start[g + 1] += 1;
+    }
+    for g in 0..ng {
+        start[g + 1] += start[g];
+    }
+    let mut fill = start.clone();
+    let mut vars = vec![0; n];
+    let mut local = vec![0; n];
+    for (i, &g) in groups.iter().enumerate() {
+        local[i] = fill[g] - start[g];
+        vars[fill[g]] = i;
+        fill[g] += 1;
+    }
+    let sz = |g: usize| start[g + 1] - start[g];
+    let mut adj: Vec<BTreeSet<usize>> = vec![BTreeSet::new(); ng];
+    let mut diag = vec![false; n];
+    for p in idx {
+        if p.row >= n || p.col >= n {
+            return Err("entry outside the matrix".into());
+        }
+        let (gr, gc) = (groups[p.row], groups[p.col]);
+        if gr != gc {
+            adj[gr].insert(gc);
+            adj[gc].insert(gr);
+        } else if p.row == p.col {
+            diag[p.row] = true;
+        }
+    }
+    // A group whose unknowns all have diagonal entries (a body) may go at any time. One
+    // without (a constraint element's multipliers) waits until every such group it
+    // touches is gone: the eliminated set is then [D Cᵀ; C 0] with all the rows C of its
+    // constraint groups, nonsingular for D near γ/h M and constraints of full row rank,
+    // whatever the order. (Taken after one body only, a ground joint can use up that
+    // body's freedom before the body's next joint comes: a four-bar's crank pin.)
+    let full: Vec<bool> = (0..ng).map(|g| vars[start[g]..start[g + 1]].iter().all(|&v| diag[v])).collect();
+    let mut waiting: Vec<usize> =
+        (0..ng).map(|g| if full[g] { 0 } else { adj[g].iter().filter(|&&j| full[j]).count() }).collect();
+    let touches: Vec<Vec<usize>> = (0..ng)
+        .map(|g| if full[g] { adj[g].iter().copied().filter(|&j| !full[j]).collect() } else { Vec::new() })
+        .collect();
+    let degree = |adj: &BTreeSet<usize>| adj.iter().map(|&j| sz(j)).sum::<usize>();
+    let mut deg: Vec<usize> = adj.iter().map(degree).collect();
+    let mut queue: BTreeSet<(usize, usize)> =
+        (0..ng).filter(|&g| waiting[g] == 0 && sz(g) > 0).map(|g| (deg[g], g)).collect();
+    let mut gone = vec![false; ng];
+    let mut order = Vec::with_capacity(ng);
+    let mut later_sets = Vec::with_capacity(ng);
+    while let Some((_, k)) = queue.pop_first() {
+        gone[k] = true;
+        let nbr: Vec<usize> = adj[k].iter().copied().collect();
+        for &i in &nbr {
+            adj[i].remove(&k);
+            for &j in &nbr {
+                if i != j {
+                    adj[i].insert(j);
+                }
+            }
+        }
+        for &i in &touches[k] {
+            waiting[i] -= 1;
+        }
+        for &i in &nbr {
+            queue.remove(&(deg[i], i));
+            deg[i] = degree(&adj[i]);
+            if waiting[i] == 0 {
+                queue.insert((deg[i], i));
+            }
+        }
+        order.push(k);
+        later_sets.push(nbr);
+    }
+    debug_assert!(gone.iter().enumerate().all(|(g, &x)| x || sz(g) == 0));
+    // Arena: every block a step touches.
+    let mut place: HashMap<(usize, usize), usize> = HashMap::new();
+    let mut arena = 0usize;
+    let mut at = |i: usize, j: usize, place: &mut HashMap<(usize, usize), usize>| -> usize {
+        *place.entry((i, j)).or_insert_with(|| {
+            let o = arena;
+            arena += sz(i) * sz(j);
+            o
+        })
+    };
+    let (mut steps, mut offs, mut later) = (Vec::with_capacity(ng), Vec::new(), Vec::new());
+    for (&k, nbr) in order.iter().zip(&later_sets) {
+        let diag = at(k, k, &mut place);
+        let (l0, o0) = (later.len(), offs.len());
+        later.extend_from_slice(nbr);
+        for &j in nbr {
+            offs.push(at(k, j, &mut place));
+        }
+        for &j in nbr {
+            offs.push(at(j, k, &mut place));
+        }
+        for &i in nbr {
+            for &j in nbr {
+                offs.push(at(i, j, &mut place));
+            }
+        }
+        steps.push(Step { k, diag, l0, nl: nbr.len(), o0 });
+    }
+    let slot = idx
+        .iter()
+        .map(|p| {
+            let (gr, gc) = (groups[p.row], groups[p.col]);
+            place[&(gr, gc)] + local[p.row] + local[p.col] * sz(gr)
+        })
+        .collect();
+    Ok(Symbolic { n, pattern: idx.to_vec(), groups: groups.to_vec(), start, vars, slot, steps, offs, later, arena })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dae::sparse::SparseLu;
+    use faer::c64;
+
+    /// n, the entries, their values, the groups.
+    type Chain = (usize, Vec<Pair<usize, usize>>, Vec<f64>, Vec<usize>);
+
+    /// A chain of `nb` "bodies" (3 unknowns each, diagonally dominant) joined by
+    /// 2-row "constraints" with zero diagonal blocks, plus a loop-closing constraint
+    /// between the last body and the first: the pattern of a closed chain's KKT-like
+    /// iteration matrix.
+    fn chain(nb: usize, close: bool) -> Chain {
+        let nj = if close { nb } else { nb - 1 };
+        let n = 3 * nb + 2 * nj;
+        let (mut idx, mut vals, mut groups) = (Vec::new(), Vec::new(), vec![0; n]);
+        let mut rnd = 0.123_f64;
+        let mut next = || {
+            rnd = (rnd * 3.7 + 0.31).fract();
+            rnd - 0.5
+        };
+        for b in 0..nb {
+            for r in 0..3 {
+                groups[3 * b + r] = b;
+                for c in 0..3 {
+                    idx.push(Pair::new(3 * b + r, 3 * b + c));
+                    vals.push(if r == c { 4.0 } else { next() });
+                }
+            }
+        }
+        for j in 0..nj {
+            let row = 3 * nb + 2 * j;
+            let (b1, b2) = (j, (j + 1) % nb);
+            for r in 0..2 {
+                groups[row + r] = nb + j;
+                for b in [b1, b2] {
+                    for c in 0..3 {
+                        let v = next() + if c == r { 1.0 } else { 0.0 };
+                        idx.push(Pair::new(row + r, 3 * b + c));
+                        vals.push(v);
+                        idx.push(Pair::new(3 * b + c, row + r));
+                        vals.push(v + 0.1 * next());
+                    }
+                }
+            }
+        }
+        (n, idx, vals, groups)
+    }
+
+    fn residual(n: usize, idx: &[Pair<usize, usize>], vals: &[f64], x: &[f64], b: &[f64]) -> f64 {
+        let mut ax = vec![0.0; n];
+        for (p, v) in idx.iter().zip(vals) {
+            ax[p.row] += v * x[p.col];
+        }
+        ax.iter().zip(b).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max)
+    }
+
+    #[test]
+    fn solves_open_and_closed_chains_as_the_general_lu_does() {
+        for close in [false, true] {
+            let (n, idx, vals, groups) = chain(30, close);
+            let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin()).collect();
+            let mut blu = BlockLu::<f64>::default();
+            blu.factor(n, &idx, &vals, &groups).expect("block LU");
+            let mut x = b.clone();
+            assert!(blu.solve(&mut x));
+            // Against the independent general LU (row pivoting): the same solution to
+            // round-off of this well-conditioned matrix, and a residual at round-off.
+            let mut glu = SparseLu::<f64>::default();
+            glu.factor_values(n, &idx, &vals).expect("general LU");
+            let mut xg = b.clone();
+            assert!(glu.solve(&mut xg));
+            let diff = x.iter().zip(&xg).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+            assert!(diff < 1e-11, "close {close}: differs from the general LU by {diff:e}");
+            assert!(residual(n, &idx, &vals, &x, &b) < 1e-12);
+            // A refactorization with new values reuses the analysis.
+            let vals2: Vec<f64> = vals.iter().map(|v| v * 1.5).collect();
+            blu.factor(n, &idx, &vals2, &groups).expect("block LU");
+            let mut x2 = b.clone();
+            assert!(blu.solve(&mut x2));
+            assert!(residual(n, &idx, &vals2, &x2, &b) < 1e-12);
+            assert_eq!(blu.analyses, 1);
+        }
+    }
+
+    #[test]
+    fn complex_values_solve_to_round_off() {
+        let (n, idx, vals, groups) = chain(12, true);
+        let cv: Vec<c64> = vals.iter().enumerate().map(|(i, &v)| c64::new(v, 0.3 * (i as f64).cos())).collect();
+        let mut blu = BlockLu::<c64>::default();
+        blu.factor(n, &idx, &cv, &groups).expect("block LU");
+        let b: Vec<c64> = (0..n).map(|i| c64::new(1.0, i as f64 * 0.1)).collect();
+        let mut x = b.clone();
+        assert!(blu.solve(&mut x));
+        let mut ax = vec![c64::new(0.0, 0.0); n];
+        for (p, v) in idx.iter().zip(&cv) {
+            ax[p.row] += *v * x[p.col];
+        }
+        let r = ax.iter().zip(&b).map(|(a, b)| (*a - *b).norm()).fold(0.0, f64::max);
+        assert!(r < 1e-12, "residual {r:e}");
+    }
+
+    #[test]
+    fn a_block_that_needs_pivoting_between_groups_is_refused() {
+        // Two singleton groups [[0, 1], [1, 0]]: each diagonal block is zero, only a row
+        // interchange across the groups factors it.
+        let idx = vec![Pair::new(0, 1), Pair::new(1, 0), Pair::new(0, 0), Pair::new(1, 1)];
+        let vals = vec![1.0, 1.0, 0.0, 0.0];
+        let mut blu = BlockLu::<f64>::default();
+        let err = blu.factor(2, &idx, &vals, &[0, 1]).unwrap_err();
+        assert!(err.contains("zero diagonal block") || err.contains("pivot"), "{err}");
+        let mut x = vec![1.0, 2.0];
+        assert!(!blu.solve(&mut x), "no factorization is held after a failure");
+        // In one group the block pivots inside: x = [2, 1].
+        blu.factor(2, &idx, &vals, &[0, 0]).expect("one group");
+        assert!(blu.solve(&mut x));
+        assert_eq!(x, vec![2.0, 1.0]);
+    }
+}
