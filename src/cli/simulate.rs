@@ -49,8 +49,9 @@ pub struct SimulateArgs {
     pub r#static: bool,
     /// At the end of the run (also a failed one), print the integrator's statistics
     /// (step attempts, accepted and rejected steps, Newton iterations, Jacobian
-    /// evaluations, factorizations (and those the block LU left to the general one), symbolic analyses, rhs evaluations; totals and per
-    /// communication step) and the wall time to stderr.
+    /// evaluations, factorizations and those the block LU left to the general one,
+    /// symbolic analyses, rhs evaluations; totals and per communication step) and the
+    /// wall time to stderr.
     #[arg(long)]
     pub stats: bool,
     /// Input signals: CSV with a `time` column and one column per input (linear between

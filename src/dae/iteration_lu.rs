@@ -13,11 +13,18 @@ pub struct IterationLu<T: LuScalar> {
     block: BlockLu<T>,
     general: SparseLu<T>,
     on_block: bool,
+    /// [`general_only`], read once (not in the step loop).
+    general_only: bool,
 }
 
 impl<T: LuScalar> Default for IterationLu<T> {
     fn default() -> Self {
-        IterationLu { block: BlockLu::default(), general: SparseLu::default(), on_block: false }
+        IterationLu {
+            block: BlockLu::default(),
+            general: SparseLu::default(),
+            on_block: false,
+            general_only: general_only(),
+        }
     }
 }
 
@@ -31,7 +38,7 @@ impl<T: LuScalar> IterationLu<T> {
     /// Factor the n×n matrix with entries `vals` at `idx` (duplicates summed); unknown i
     /// belongs to group `groups[i]` (empty: no groups, the general LU).
     pub fn factor(&mut self, n: usize, idx: &[Pair<usize, usize>], vals: &[T], groups: &[usize]) -> Result<(), String> {
-        self.on_block = !groups.is_empty() && !general_only() && self.block.factor(n, idx, vals, groups).is_ok();
+        self.on_block = !groups.is_empty() && !self.general_only && self.block.factor(n, idx, vals, groups).is_ok();
         if self.on_block { Ok(()) } else { self.general.factor_values(n, idx, vals) }
     }
 
@@ -46,7 +53,7 @@ impl<T: LuScalar> IterationLu<T> {
         self.block.analyses + self.general.analyses
     }
 
-    /// Whether the last factorization was the block LU (for tests and statistics).
+    /// Whether the last factorization was the block LU (for the statistics).
     pub fn on_block(&self) -> bool {
         self.on_block
     }
