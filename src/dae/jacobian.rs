@@ -4,6 +4,7 @@
 use super::layout::Layout;
 use super::sparse::Triplets;
 use crate::ad::chunked;
+use crate::geom::M3;
 use crate::mechanics::System;
 use crate::mechanics::body::{NQ, h_angular};
 use crate::mechanics::constraint_jacobian::p_row_into;
@@ -26,6 +27,9 @@ struct At<'a> {
     u: &'a [f64],
     /// External values [inputs; Z; L] at y.
     ext: &'a [f64],
+    /// Each body's angular block of H (Eq. 12), formed once per Jacobian: every
+    /// constraint equation's P row and (Pᵀλ)_q column reads it.
+    h: &'a [M3<f64>],
 }
 
 /// J = ∂f/∂y, exact except for the term ∂(C_qᵀμ)/∂q, which vanishes on the solution (μ = 0).
@@ -39,6 +43,8 @@ pub fn jacobian(sys: &System, lay: Layout, t: f64, y: &[f64], inputs: &[f64], ja
 pub struct JacScratch {
     /// The external values.
     ext: Vec<f64>,
+    /// The bodies' angular blocks of H.
+    h: Vec<M3<f64>>,
     rows: RowBuffers,
 }
 
@@ -69,7 +75,10 @@ pub fn jacobian_with(
 ) {
     lay.ext_into(sys, inputs, y, t, &mut ws.ext);
     let ext = &ws.ext;
-    let at = At { sys, lay, t, y, q: &y[lay.q_range()], u: &y[lay.u_range()], ext };
+    let q = &y[lay.q_range()];
+    ws.h.clear();
+    ws.h.extend((0..sys.nb()).map(|b| h_angular(q[NQ * b + 4], q[NQ * b + 5])));
+    let at = At { sys, lay, t, y, q, u: &y[lay.u_range()], ext, h: &ws.h };
     let lc = LoadChain::new(sys, lay, y, t, ext);
     user_rows(&at, &lc, jac);
     kinematic_rows(&at, jac);
@@ -126,7 +135,7 @@ fn kinematic_rows(at: &At, jac: &mut Triplets) {
         for c in 0..3 {
             jac.push(o + c, nu + o + c, 1.0);
         }
-        let h = h_angular(qb[4], qb[5]);
+        let h = &at.h[b];
         for r in 0..3 {
             for c in 0..3 {
                 jac.push(o + 3 + r, nu + o + 3 + c, h.0[r][c]);
@@ -249,7 +258,7 @@ fn constraint_rows(at: &At, ws: &mut RowBuffers, jac: &mut Triplets) {
             let hs = &s.hess[e * k * k..(e + 1) * k * k];
             constraint_row(at, &el.bodies, row, g, hs, &ws.rates, &mut ws.p, jac);
             if lam != 0.0 {
-                add_pt_lambda_q(at.sys, &el.bodies, at.q, lam, g, hs, (&mut ws.col, &mut ws.ht), &mut ws.lq);
+                add_pt_lambda_q(at, &el.bodies, lam, g, hs, (&mut ws.col, &mut ws.ht), &mut ws.lq);
             }
         }
         push_pt_lambda_q(at, &el.bodies, &ws.lq, jac);
@@ -290,7 +299,7 @@ fn constraint_row(
     let (nu, nl, nm) = (at.lay.u(), at.lay.lam(), at.lay.mu());
     let (nql, k) = (nql(at.sys, bodies), g.len());
     p.resize(nql, 0.0);
-    p_row_into(bodies, |b| h_angular(at.q[NQ * b + 4], at.q[NQ * b + 5]), &g[..nql], p);
+    p_row_into(bodies, |b| at.h[b], &g[..nql], p);
     for a in 0..nql {
         let ga = global_column(at.sys, bodies, a);
         // C_q (Eq. 13e rows), −C_qᵀ (q̇ rows, μ column), −Pᵀ (u rows, λ column), P (Ċ rows).
@@ -317,22 +326,21 @@ fn constraint_row(
 /// row-major nql × nql), from its gradient `g` and Hessian `hs` (`bufs`: two buffers).
 #[allow(clippy::too_many_arguments)]
 fn add_pt_lambda_q(
-    sys: &System,
+    at: &At,
     bodies: &[usize],
-    q: &[f64],
     lam: f64,
     g: &[f64],
     hs: &[f64],
     bufs: (&mut Vec<f64>, &mut Vec<f64>),
     lq: &mut [f64],
 ) {
-    let (nql, k) = (nql(sys, bodies), g.len());
+    let (q, nql, k) = (at.q, nql(at.sys, bodies), g.len());
     let (col, ht) = bufs;
     ht.resize(nql, 0.0);
     for a in 0..nql {
         col.clear();
         col.extend((0..nql).map(|c| hs[c * k + a]));
-        p_row_into(bodies, |b| h_angular(q[NQ * b + 4], q[NQ * b + 5]), col, ht);
+        p_row_into(bodies, |b| at.h[b], col, ht);
         for r in 0..nql {
             lq[r * nql + a] += lam * ht[r];
         }

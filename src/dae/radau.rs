@@ -138,6 +138,11 @@ pub struct Radau {
     /// Jacobian values of a restored state, put in place at the next step (the pattern
     /// may first have to be evaluated).
     jac_restored: Option<Vec<f64>>,
+    /// The step attempt is held short of its natural size (by the communication grid):
+    /// [`THET_HELD`] and a tighter Newton tolerance ([`newton_scale`]) apply.
+    held: bool,
+    /// [`newton_scale`] of the step attempt.
+    newton_scale: f64,
     /// Counts since [`Radau::new`].
     pub stats: Stats,
 }
@@ -161,13 +166,34 @@ const NIT: usize = 7;
 const SAFE: f64 = 0.9;
 const FACL: f64 = 5.0;
 const FACR: f64 = 0.125;
-/// Recompute the Jacobian after a step whose Newton contraction rate exceeded this.
-/// RADAU5 suggests 0.1 when J is expensive (here about 15 evaluations of f plus two
-/// factorizations). Measured on the swing chain of `bench/` at 1 ms communication steps
-/// (N = 10, tol 1e-4 and 1e-5, largest tip error over 1 s against tol 1e-11): 0.1 gives
-/// 2.8e-6 m, no worse than a fresh J at every step; 0.3 saves a third of the Jacobians
-/// but lets the error grow to 7e-5 m.
+/// Recompute the Jacobian after a step whose Newton contraction rate exceeded this, when
+/// the next step may change h (a new h needs a new factorization anyway, so a fresh J
+/// costs only its evaluation). RADAU5 suggests 0.1 when J is expensive (here about 15
+/// evaluations of f).
 const THET: f64 = 0.1;
+/// [`THET`] for a step held short by the communication grid (the next one has the same
+/// h and keeps the factorization, so a fresh J costs J and both factorizations, 8–10
+/// Newton iterations on the swing chains of `bench/`). Measured with [`KAPPA_MIN`] on
+/// those chains at 1 ms communication steps, tol 1e-4, against a tol-1e-10 reference
+/// (tip error at 1 s; cost from the counts and `examples/kernel_times`): N = 10: THET
+/// 0.1 / 0.2 / 0.3 / 0.5 cost 1.06 / 1.01 / 1.00 / 1.00 (0.3 = 1) at errors 4.9e-7 /
+/// 9.6e-7 / 8.1e-7 / 5.6e-6 m; N = 100: 1.10 / 1.00 / 1.00 / 1.02 at 1.1e-3 / 7.2e-4 /
+/// 6.2e-4 / 6.8e-4 m.
+const THET_HELD: f64 = 0.3;
+/// Floor of the factor on RADAU5's Newton tolerance in a step held short (see
+/// [`newton_scale`]). Measured as for [`THET_HELD`]: with RADAU5's tolerance alone the
+/// Newton error, not the method's, set the tip error at 1 ms steps (N = 10: 1.3e-6 m,
+/// N = 100: 9.4e-3 m; with 0.1: 6.4e-7, 5.2e-3; 0.03: 8.1e-7, 6.2e-4; 0.01: 1.4e-6,
+/// 6.1e-5 at 4 % more cost than 0.03).
+const KAPPA_MIN: f64 = 0.03;
+
+/// The factor on RADAU5's Newton tolerance for a step h where the error control asks for
+/// `natural`: the step's truncation error shrinks like (h / natural)⁴ (the error
+/// estimate's order plus one), and the Newton error is kept below it, down to
+/// [`KAPPA_MIN`]; 1 for a step of its natural size.
+fn newton_scale(h: f64, natural: f64) -> f64 {
+    if h < natural { (h / natural).powi(4).clamp(KAPPA_MIN, 1.0) } else { 1.0 }
+}
 
 impl Radau {
     /// New integrator at (t0, y0) with tolerance `tol` (relative and absolute).
@@ -209,6 +235,8 @@ impl Radau {
             last_rejected: false,
             faccon: 1.0,
             jac_restored: None,
+            held: false,
+            newton_scale: 1.0,
             stats: Stats::default(),
         }
     }
@@ -328,6 +356,7 @@ impl Radau {
             attempts += 1;
             let natural = self.h.min(self.max_step);
             let h = split_rest(t_end - self.t, natural);
+            (self.held, self.newton_scale) = (h < natural, newton_scale(h, natural));
             let (ok, hnew) = self.step(p, h)?;
             if ok {
                 // A step shortened to land on t_end keeps the natural size for later
@@ -498,7 +527,7 @@ impl Radau {
                 wk.w[r][i] = (0..3).map(|s| tb.ti[r][s] * wk.z[s][i]).sum();
             }
         }
-        let fnewt = (10.0 * f64::EPSILON / self.rtol).max(0.03f64.min(self.rtol.sqrt()));
+        let fnewt = (10.0 * f64::EPSILON / self.rtol).max(self.newton_scale * 0.03f64.min(self.rtol.sqrt()));
         let mut faccon = self.faccon.max(f64::EPSILON).powf(0.8);
         let mut dyno_old = 0.0;
         // One iteration that converges: as fast as no Jacobian refresh asks (RADAU5).
@@ -672,7 +701,7 @@ impl Radau {
         self.last_rejected = false;
         self.stats.accepted += 1;
         self.jac_fresh = false;
-        self.need_jac = theta > THET;
+        self.need_jac = theta > if self.held { THET_HELD } else { THET };
         self.f0_valid = false;
         if p.accepted(self.t, &mut self.y) {
             self.drop_polynomial();
