@@ -15,9 +15,9 @@ use mbfmu::model::parse::load_file;
 use std::time::Instant;
 
 /// Radau IIA's γ, α, β (the eigenvalues of the inverse of its coefficient matrix).
-const GAMMA: f64 = 3.637834252744496;
-const ALPHA: f64 = 2.681082873627752;
-const BETA: f64 = 3.050430199247410;
+const GAMMA: f64 = 3.637_834_252_744_496;
+const ALPHA: f64 = 2.681_082_873_627_752;
+const BETA: f64 = 3.050_430_199_247_41;
 
 /// The fastest of 10 batches of `reps` calls, per call (the minimum filters a shared
 /// machine's noise).
