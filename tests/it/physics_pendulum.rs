@@ -51,3 +51,35 @@ fn pendulum_at_170_deg_has_the_elliptic_period() {
     assert!((dt / period).abs() < 1e-7, "relative period error {:e}", dt / period);
     assert!(sim.constraint_residual() < 1e-10);
 }
+
+/// The same swing co-simulated in 1 ms communication steps (steps held short of their
+/// natural size by the grid, which keep their factorization and converge Newton below
+/// their truncation error): the half period against the elliptic integral to the
+/// requested tolerance, and the work counted.
+#[test]
+fn pendulum_in_1_ms_communication_steps_keeps_the_elliptic_period() {
+    let theta0 = 170f64.to_radians();
+    let model = load_str(&pendulum(theta0), "pendulum.xml").expect("model loads");
+    let (m, g, l, jyy): (f64, f64, f64, f64) = (2.0, 9.81, 1.0, 0.3);
+    let w0 = (m * g * l / (jyy + m * l * l)).sqrt();
+    let period = 4.0 * ellip_k((theta0 / 2.0).sin()) / w0;
+    let tol = 1e-6;
+    let mut sim =
+        Simulator::new(&model, SimOptions { tol, max_step: None, ..Default::default() }, 0.0).expect("initializes");
+    let steps = (0.5 * period / 1e-3).floor() as usize;
+    for k in 1..=steps {
+        sim.advance(k as f64 * 1e-3).expect("integrates");
+    }
+    sim.advance(0.5 * period).expect("integrates");
+    let w = sim.outputs().unwrap()[0];
+    let dt = w / (w0 * w0 * theta0.sin());
+    let st = sim.stats();
+    eprintln!("period {period}, dt {dt:e}, stats {st:?}, |C| {:e}", sim.constraint_residual());
+    // The phase error of the half period, relative, within the tolerance asked for.
+    assert!((dt / period).abs() < tol, "relative period error {:e}", dt / period);
+    assert!(sim.constraint_residual() < tol * 1e-3, "|C| {:e}", sim.constraint_residual());
+    // Held steps keep J and its LU for several steps; none is rejected (a slow Newton
+    // iteration takes a fresh J within the step).
+    assert!(st.jacobians * 4 < st.accepted, "{} Jacobians for {} steps", st.jacobians, st.accepted);
+    assert!(st.rejected <= 2, "{} rejected steps", st.rejected);
+}
