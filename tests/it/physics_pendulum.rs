@@ -55,7 +55,7 @@ fn pendulum_at_170_deg_has_the_elliptic_period() {
 /// The same swing co-simulated in 1 ms communication steps (steps held short of their
 /// natural size by the grid, which keep their factorization and converge Newton below
 /// their truncation error): the half period against the elliptic integral to the
-/// requested tolerance, and the work counted.
+/// requested tolerance (2.5e-8 relative measured), and the work counted.
 #[test]
 fn pendulum_in_1_ms_communication_steps_keeps_the_elliptic_period() {
     let theta0 = 170f64.to_radians();
@@ -78,8 +78,9 @@ fn pendulum_in_1_ms_communication_steps_keeps_the_elliptic_period() {
     // The phase error of the half period, relative, within the tolerance asked for.
     assert!((dt / period).abs() < tol, "relative period error {:e}", dt / period);
     assert!(sim.constraint_residual() < tol * 1e-3, "|C| {:e}", sim.constraint_residual());
-    // Held steps keep J and its LU for several steps; none is rejected (a slow Newton
-    // iteration takes a fresh J within the step).
-    assert!(st.jacobians * 4 < st.accepted, "{} Jacobians for {} steps", st.jacobians, st.accepted);
+    // Held steps keep J and its LU for many steps (35 Jacobians in 2626 steps; 67 with
+    // the threshold of free-running steps); none is rejected (a slow Newton iteration
+    // takes a fresh J within the step).
+    assert!(st.jacobians * 50 < st.accepted, "{} Jacobians for {} steps", st.jacobians, st.accepted);
     assert!(st.rejected <= 2, "{} rejected steps", st.rejected);
 }
