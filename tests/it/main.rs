@@ -18,6 +18,7 @@ mod bicycle_benchmark;
 mod block_lu;
 mod bounded_step;
 mod bushing;
+mod chain_work;
 mod cli;
 mod cli_linearize;
 mod cli_set;
