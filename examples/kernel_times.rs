@@ -3,7 +3,8 @@
 //! iteration matrix of a 1 ms Radau step.
 //! Usage: cargo run --release --example kernel_times -- model.xml [kernel ...]
 //! Kernels: rhs, jacobian, block, general (all when none is named; name one to profile
-//! it alone under `perf`).
+//! it alone under `perf`); `exact`: the exact J instead of the integrator's iteration
+//! approximation (`JacScratch::within_bodies`).
 use faer::c64;
 use faer::sparse::Pair;
 use mbfmu::dae::block_lu::BlockLu;
@@ -36,7 +37,9 @@ fn time(name: &str, reps: usize, mut work: impl FnMut()) {
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    let want = |k: &str| args.len() < 3 || args[2..].iter().any(|a| a == k);
+    let named: Vec<&String> = args.iter().skip(2).filter(|a| *a != "exact").collect();
+    let want = |k: &str| named.is_empty() || named.iter().any(|a| *a == k);
+    let exact = args.iter().skip(2).any(|a| a == "exact");
     let model = load_file(std::path::Path::new(&args[1])).unwrap_or_else(|e| panic!("{e}"));
     let sim = Simulator::new(&model, SimOptions::default(), 0.0).unwrap_or_else(|e| panic!("{e}"));
     let sys = sim.system();
@@ -49,6 +52,7 @@ fn main() {
         time("rhs", 500, || rhs(sys, lay, 0.0, &y, &inputs, &mut ws, &mut f));
     }
     let (mut j, mut js) = (Triplets::new(), JacScratch::default());
+    js.within_bodies = !exact;
     jacobian_with(sys, lay, 0.0, &y, &inputs, &mut js, &mut j);
     if want("jacobian") {
         time("jacobian", 50, || {

@@ -57,6 +57,9 @@ impl DaeProblem for MultibodyDae {
     fn groups(&self) -> Vec<usize> {
         self.lay.groups(&self.sys)
     }
+    fn set_exact_jacobian(&mut self, exact: bool) {
+        self.jws.within_bodies = !exact;
+    }
     fn accepted(&mut self, t: f64, y: &mut [f64]) -> bool {
         let (qs, us) = (self.lay.q_range(), self.lay.u_range());
         let changed = self.sys.rebase_frames(&mut y[qs.clone()]);

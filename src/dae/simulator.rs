@@ -142,10 +142,13 @@ impl Simulator {
     }
 
     /// The pencil (J, M) of the DAE M y' = f(t, y) at the current point, J = ∂f/∂y exact
-    /// and sparse (the integrator's), with f there and the multipliers (λ, ν) of y.
+    /// and sparse, with f there and the multipliers (λ, ν) of y.
     pub fn pencil(&mut self) -> Result<(Triplets, Triplets, Vec<f64>, Vec<f64>), EngineError> {
         let (t, y) = (self.radau.t, self.radau.y.clone());
         let mut j = Triplets::new();
+        // The exact J, not the integrator's iteration approximation (it asks for its own
+        // kind again before its next Jacobian).
+        self.dae.set_exact_jacobian(true);
         self.dae.jacobian(t, &y, &mut j).map_err(EngineError::Numeric)?;
         let mut m = Triplets::new();
         self.dae.mass(&mut m);

@@ -202,6 +202,15 @@ impl System {
         NQ * self.bodies.len()..self.n()
     }
 
+    /// The body whose coordinate q[`i`] is: its six rigid ones come body by body, then
+    /// each flexible body's modal ones.
+    pub fn body_of_coordinate(&self, i: usize) -> usize {
+        if i < NQ * self.bodies.len() {
+            return i / NQ;
+        }
+        self.flex.iter().find(|f| f.eta.contains(&i)).map_or(self.bodies.len(), |f| f.body)
+    }
+
     /// Where body `b`'s modal coordinates sit in q (empty for a rigid body).
     pub fn modal_range(&self, b: usize) -> std::ops::Range<usize> {
         self.flex.iter().find(|f| f.body == b).map_or(0..0, |f| f.eta.clone())

@@ -7,7 +7,7 @@
 //! 68 local coordinates, so every derivative kernel seeds its dual numbers a chunk at a
 //! time, and those chunked derivatives are checked the same way.
 
-use mbfmu::dae::equations::{Layout, jacobian, rhs};
+use mbfmu::dae::equations::{JacScratch, Layout, jacobian, jacobian_with, rhs};
 use mbfmu::dae::residual::RhsScratch;
 use mbfmu::dae::sparse::Triplets;
 use mbfmu::mechanics::System;
@@ -235,6 +235,65 @@ fn jacobian_matches_central_differences((sys, lay, y): (System, Layout, Vec<f64>
         }
     }
     assert!(worst.0 < 1e-6, "worst relative error {:e} at row {} col {}", worst.0, worst.1, worst.2);
+}
+
+#[test]
+fn the_iteration_matrix_leaves_out_only_the_cross_body_constraint_force_derivatives() {
+    iteration_matrix_differs_only_across_bodies(setup());
+}
+
+#[test]
+fn the_iteration_matrix_of_a_fifty_mode_body_keeps_its_own_modal_coupling() {
+    iteration_matrix_differs_only_across_bodies(setup_flexible("iteration-matrix"));
+}
+
+/// The integrator's iteration matrix (`JacScratch::within_bodies`) against the exact J,
+/// entry by entry: they differ only in force-balance rows of one body (its u rows, or the
+/// acceleration rows they move to) × q columns of another, the constraint forces' change
+/// with the other body's pose, which the exact J has there (at random λ of O(1)); with
+/// λ = 0 they agree everywhere. Entry sums are formed in the same order, so agreement is
+/// to round-off of one sum (1e-13 relative to max(1, |J|)).
+fn iteration_matrix_differs_only_across_bodies((sys, lay, mut y): (System, Layout, Vec<f64>)) {
+    let t = 0.37;
+    let n = lay.dim();
+    let dense = |y: &[f64], within_bodies: bool| {
+        let mut ws = JacScratch::default();
+        ws.within_bodies = within_bodies;
+        let mut trip = Triplets::new();
+        jacobian_with(&sys, lay, t, y, &INPUTS, &mut ws, &mut trip);
+        let mut jd = vec![0.0; n * n];
+        for (p, v) in trip.idx.iter().zip(&trip.vals) {
+            jd[p.row * n + p.col] += v;
+        }
+        jd
+    };
+    // The body of each force-balance row: u rows, and acceleration rows by their dof.
+    let mut row_body = vec![None; n];
+    for g in 0..lay.n {
+        row_body[lay.u() + g] = Some(sys.body_of_coordinate(g));
+        if let Some(r) = lay.acc_row(&sys.acc_bodies, g) {
+            row_body[r] = Some(sys.body_of_coordinate(g));
+        }
+    }
+    let (exact, approx) = (dense(&y, false), dense(&y, true));
+    let mut dropped = 0.0f64;
+    for r in 0..n {
+        for c in 0..n {
+            let d = (exact[r * n + c] - approx[r * n + c]).abs();
+            let across = c < lay.n && row_body[r].is_some_and(|b| b != sys.body_of_coordinate(c));
+            if across {
+                dropped = dropped.max(d);
+            } else {
+                assert!(d <= 1e-13 * exact[r * n + c].abs().max(1.0), "row {r} col {c}: {d:e} apart");
+            }
+        }
+    }
+    assert!(dropped > 1e-2, "no cross-body entry left out (largest {dropped:e})");
+    y[lay.lam_range()].fill(0.0);
+    let (exact, approx) = (dense(&y, false), dense(&y, true));
+    for (i, (e, a)) in exact.iter().zip(&approx).enumerate() {
+        assert!((e - a).abs() <= 1e-13 * e.abs().max(1.0), "λ = 0, entry {i}: {e} vs {a}");
+    }
 }
 
 #[test]

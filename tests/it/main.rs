@@ -34,6 +34,7 @@ mod fmi3_sequences;
 mod fmi_capi;
 mod fmi_layer;
 mod fmi_sequences;
+mod iteration_matrix;
 mod jacobians;
 mod linearize;
 mod linearize_loads;
