@@ -368,9 +368,10 @@ fn push_pt_lambda_q(at: &At, bodies: &[usize], lq: &[f64], within_bodies: bool, 
     let (nu, nql) = (at.lay.u(), nql(at.sys, bodies));
     for r in 0..nql {
         let row = global_column(at.sys, bodies, r);
+        let row_body = at.sys.body_of_coordinate(row);
         for a in 0..nql {
             let col = global_column(at.sys, bodies, a);
-            if within_bodies && at.sys.body_of_coordinate(row) != at.sys.body_of_coordinate(col) {
+            if within_bodies && at.sys.body_of_coordinate(col) != row_body {
                 continue;
             }
             jac.push(nu + row, col, -lq[r * nql + a]);

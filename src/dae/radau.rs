@@ -336,10 +336,11 @@ impl Radau {
         self.h_old = v[0];
         self.faccon = v[1];
         self.first = v[2] != 0.0;
-        self.last_rejected = v[3] == 1.0 || v[3] == 3.0;
+        let flags = v[3] as u8;
+        self.last_rejected = flags & 1 != 0;
+        self.exact_jac = flags & 2 != 0;
         self.cont = (v[4] != 0.0).then(|| std::array::from_fn(|k| v[5 + k * n..5 + (k + 1) * n].to_vec()));
         self.restart();
-        self.exact_jac = v[3] >= 2.0;
         if jac {
             self.need_jac = v[base + 1] != 0.0;
             self.jac_fresh = v[base + 2] != 0.0;
