@@ -21,6 +21,14 @@ use std::collections::{BTreeSet, HashMap};
 /// pivoting then takes the matrix).
 pub const PIVOT_TOL: f64 = 1e-12;
 
+/// Scratch of an elimination step: its diagonal block, its row blocks side by side,
+/// its L column blocks one after the other.
+struct Scratch<T> {
+    d: Vec<T>,
+    u: Vec<T>,
+    l: Vec<T>,
+}
+
 /// The symbolic part: groups, elimination order, where each block lives.
 struct Symbolic {
     n: usize,
@@ -61,11 +69,11 @@ pub struct BlockLu<T: LuScalar> {
     arena: Vec<T>,
     /// Row interchanges of each diagonal block (LAPACK's ipiv, local indices), by `start`.
     piv: Vec<usize>,
-    /// Scratch: a step's diagonal block, its U row blocks and L column blocks, the work
-    /// vector of a solve.
-    d: Vec<T>,
-    u: Vec<T>,
-    l: Vec<T>,
+    /// Reciprocals of U's diagonal in each diagonal block, by `start`.
+    rdiag: Vec<T>,
+    /// Scratch of an elimination step.
+    scratch: Scratch<T>,
+    /// The work vector of a solve.
     w: Vec<T>,
     factored: bool,
     /// Number of symbolic analyses performed.
@@ -78,9 +86,8 @@ impl<T: LuScalar> Default for BlockLu<T> {
             sym: None,
             arena: Vec::new(),
             piv: Vec::new(),
-            d: Vec::new(),
-            u: Vec::new(),
-            l: Vec::new(),
+            rdiag: Vec::new(),
+            scratch: Scratch { d: Vec::new(), u: Vec::new(), l: Vec::new() },
             w: Vec::new(),
             factored: false,
             analyses: 0,
@@ -98,13 +105,14 @@ impl<T: LuScalar> BlockLu<T> {
         if !reuse {
             let s = analyze(n, idx, groups)?;
             self.arena = vec![<T as LuScalar>::zero(); s.arena];
-            self.piv = vec![0; n];
             let widest = (0..s.start.len() - 1).map(|g| size(&s, g)).max().unwrap_or(0);
             let wide = s.steps.iter().map(|st| (0..st.nl).map(|j| size(&s, s.later[st.l0 + j])).sum::<usize>());
             let wide = wide.max().unwrap_or(0);
-            self.d = vec![<T as LuScalar>::zero(); widest * widest];
-            self.u = vec![<T as LuScalar>::zero(); widest * wide];
-            self.l = vec![<T as LuScalar>::zero(); widest * wide];
+            self.piv = vec![0; n];
+            self.rdiag = vec![<T as LuScalar>::zero(); n];
+            let zero = <T as LuScalar>::zero();
+            self.scratch =
+                Scratch { d: vec![zero; widest * widest], u: vec![zero; widest * wide], l: vec![zero; widest * wide] };
             self.w = vec![<T as LuScalar>::zero(); n];
             self.sym = Some(s);
             self.analyses += 1;
@@ -118,7 +126,7 @@ impl<T: LuScalar> BlockLu<T> {
             self.arena[k] += v;
         }
         for st in &s.steps {
-            eliminate(s, st, &mut self.arena, &mut self.piv, &mut self.d, &mut self.u, &mut self.l)?;
+            eliminate(s, st, &mut self.arena, &mut self.piv, &mut self.rdiag, &mut self.scratch)?;
         }
         self.factored = true;
         Ok(())
@@ -132,28 +140,20 @@ impl<T: LuScalar> BlockLu<T> {
         for (p, &v) in s.vars.iter().enumerate() {
             w[p] = b[v];
         }
-        // Forward: w_k ← L_kk⁻¹ P_k w_k, then w_i −= L_ik w_k for the later groups.
+        // Forward: w_i −= L_ik w_k for the groups still present after k.
         for st in &s.steps {
             let (k0, sk) = (s.start[st.k], size(s, st.k));
-            let dg = &a[st.diag..st.diag + sk * sk];
-            for (c, &p) in self.piv[k0..k0 + sk].iter().enumerate() {
-                w.swap(k0 + c, k0 + p);
-            }
-            unit_lower_solve(dg, sk, &mut w[k0..k0 + sk]);
             for j in 0..st.nl {
                 let i = s.later[st.l0 + j];
                 let (i0, si) = (s.start[i], size(s, i));
                 let off = s.offs[st.o0 + st.nl + j];
                 for c in 0..sk {
                     let x = w[k0 + c];
-                    if x.is_zero() {
-                        continue;
-                    }
                     axpy(&mut w[i0..i0 + si], &a[off + c * si..off + (c + 1) * si], x);
                 }
             }
         }
-        // Backward: w_k ← U_kk⁻¹ (w_k − Σ_j U_kj w_j).
+        // Backward: w_k ← D_kk⁻¹ (w_k − Σ_j A_kj w_j), D_kk⁻¹ = U⁻¹ L⁻¹ P.
         for st in s.steps.iter().rev() {
             let (k0, sk) = (s.start[st.k], size(s, st.k));
             for j in 0..st.nl {
@@ -162,16 +162,18 @@ impl<T: LuScalar> BlockLu<T> {
                 let off = s.offs[st.o0 + j];
                 for c in 0..sg {
                     let x = w[g0 + c];
-                    if x.is_zero() {
-                        continue;
-                    }
                     axpy(&mut w[k0..k0 + sk], &a[off + c * sk..off + (c + 1) * sk], x);
                 }
             }
             let dg = &a[st.diag..st.diag + sk * sk];
             let wk = &mut w[k0..k0 + sk];
+            for (c, &p) in self.piv[k0..k0 + sk].iter().enumerate() {
+                wk.swap(c, p);
+            }
+            unit_lower_solve(dg, sk, wk);
+            let rd = &self.rdiag[k0..k0 + sk];
             for c in (0..sk).rev() {
-                let x = wk[c] / dg[c + c * sk];
+                let x = wk[c] * rd[c];
                 wk[c] = x;
                 axpy(&mut wk[..c], &dg[c * sk..c * sk + c], x);
             }
@@ -187,43 +189,43 @@ fn size(s: &Symbolic, g: usize) -> usize {
     s.start[g + 1] - s.start[g]
 }
 
-/// Eliminate one group: LU of its diagonal block (partial pivoting inside it), its U row
-/// blocks L_kk⁻¹ P A_kj, its L column blocks A_ik U_kk⁻¹, and the Schur updates
-/// A_ij −= L_ik U_kj of the groups still present.
+/// Eliminate one group (block Gaussian elimination: the row blocks A_kj stay as they
+/// are): the LU of its diagonal block D_kk (partial pivoting inside it, its pivots
+/// checked, the reciprocals of U's diagonal kept), its L column blocks L_ik = A_ik D_kk⁻¹
+/// and the Schur updates A_ij −= L_ik A_kj of the groups still present. The forward
+/// solve is then one product per block, and no solve divides.
 fn eliminate<T: LuScalar>(
     s: &Symbolic,
     st: &Step,
     a: &mut [T],
     piv: &mut [usize],
-    d: &mut [T],
-    u: &mut [T],
-    l: &mut [T],
+    rdiag: &mut [T],
+    scratch: &mut Scratch<T>,
 ) -> Result<(), String> {
+    let Scratch { d, u, l } = scratch;
     let (k0, sk) = (s.start[st.k], size(s, st.k));
     let d = &mut d[..sk * sk];
     d.copy_from_slice(&a[st.diag..st.diag + sk * sk]);
     let piv = &mut piv[k0..k0 + sk];
     lu_in_place(d, sk, piv)?;
     a[st.diag..st.diag + sk * sk].copy_from_slice(d);
+    for (c, r) in rdiag[k0..k0 + sk].iter_mut().enumerate() {
+        *r = <T as LuScalar>::one() / d[c + c * sk];
+    }
+    let rd = &rdiag[k0..k0 + sk];
     let nbr = &s.later[st.l0..st.l0 + st.nl];
     let offs = &s.offs[st.o0..];
-    // U_kj = L_kk⁻¹ P A_kj (sk × sj), side by side in `u`; L_ik = A_ik U_kk⁻¹ (si × sk)
-    // one after the other in `l`.
+    // The row blocks A_kj side by side in `u` (sk × Σ sj, column-major); L_ik = A_ik D⁻¹
+    // = A_ik U⁻¹ L⁻¹ P (si × sk) in the arena and one after the other in `l`.
     let mut ucol = 0;
     let mut lpos = 0;
     for (j, &g) in nbr.iter().enumerate() {
         let sg = size(s, g);
         let (okj, ojk) = (offs[j], offs[st.nl + j]);
-        for c in 0..sg {
-            let col = &mut a[okj + c * sk..okj + (c + 1) * sk];
-            for (r, &p) in piv.iter().enumerate() {
-                col.swap(r, p);
-            }
-            unit_lower_solve(d, sk, col);
-            u[(ucol + c) * sk..(ucol + c + 1) * sk].copy_from_slice(col);
-        }
+        u[ucol * sk..(ucol + sg) * sk].copy_from_slice(&a[okj..okj + sg * sk]);
         ucol += sg;
         let blk = &mut a[ojk..ojk + sg * sk];
+        // X = A_ik U⁻¹, column by column.
         for c in 0..sk {
             let (left, right) = blk.split_at_mut(c * sg);
             let out = &mut right[..sg];
@@ -233,13 +235,34 @@ fn eliminate<T: LuScalar>(
                     axpy(out, &left[p * sg..(p + 1) * sg], upc);
                 }
             }
-            let inv = <T as LuScalar>::one() / d[c + c * sk];
+            let inv = rd[c];
             out.iter_mut().for_each(|v| *v *= inv);
+        }
+        // Y = X L⁻¹, the last column first.
+        for c in (0..sk).rev() {
+            let (left, right) = blk.split_at_mut((c + 1) * sg);
+            let out = &mut left[c * sg..];
+            for p in c + 1..sk {
+                let lpc = d[p + c * sk];
+                if !lpc.is_zero() {
+                    axpy(out, &right[(p - c - 1) * sg..(p - c) * sg], lpc);
+                }
+            }
+        }
+        // L_ik = Y P: the interchanges as column swaps, the last first.
+        for c in (0..sk).rev() {
+            let p = piv[c];
+            if p != c {
+                for r in 0..sg {
+                    blk.swap(r + c * sg, r + p * sg);
+                }
+            }
         }
         l[lpos..lpos + sg * sk].copy_from_slice(blk);
         lpos += sg * sk;
     }
-    // A_ij −= L_ik U_kj.
+    // A_ij −= L_ik A_kj (the zeros of A_kj skipped: a body's position rows do not touch
+    // the multipliers its velocity rows do).
     let mut lpos = 0;
     for (i, &gi) in nbr.iter().enumerate() {
         let si = size(s, gi);

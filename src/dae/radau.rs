@@ -852,8 +852,8 @@ mod tests {
     /// same engine state bit for bit; and where the arithmetic is the recording machine's,
     /// in the states and step counts recorded at the last intended numerical change (a
     /// slow Newton iteration refreshes J within the step, held steps converge tighter,
-    /// the iteration matrix leaves out the cross-body constraint Hessian: issue 26,
-    /// 2026-12-07). Update the table only for an intended numerical change.
+    /// the iteration matrix leaves out the cross-body constraint Hessian, the block LU keeps
+    /// its row blocks and divides by no pivot in a solve: issue 26, 2026-12-07). Update the table only for an intended numerical change.
     ///
     /// faer's dense kernels choose their SIMD path and blocking at run time (instruction
     /// set, cache sizes), and another choice rounds differently; so the recorded bits are
@@ -875,6 +875,8 @@ mod tests {
         let mut check = |what: &str, run: &dyn Fn() -> (u64, Vec<usize>), hash: u64, counts: &[usize]| {
             let (h, c) = run();
             assert_eq!(run(), (h, c.clone()), "{what}: a second run differs");
+            // The values to record, for an intended numerical change.
+            eprintln!("{what}: {h:#018x} {c:?}");
             let here = *recorded_here.get_or_insert_with(|| {
                 let same = isa && h == hash;
                 if !same {
@@ -887,18 +889,18 @@ mod tests {
             }
         };
         let table: [(&str, u64, usize); 12] = [
-            ("pendulum", 0xb50fbc050c3d68b9, 28),
-            ("double_pendulum", 0x170d418578d3fb57, 52),
-            ("fourbar", 0x462c89f5832daf84, 211),
-            ("slider_crank", 0x8fbdf49c6751b112, 13),
-            ("spinning_top", 0x26cc3c722c719033, 402),
+            ("pendulum", 0x0586eda5c572d449, 28),
+            ("double_pendulum", 0x57b26fc9db0f12b8, 52),
+            ("fourbar", 0x943846cdddab332e, 211),
+            ("slider_crank", 0x0380df6c641abaa1, 17),
+            ("spinning_top", 0x58b3894cb23a011f, 402),
             ("chaplygin_sleigh", 0x2e83c4f458842171, 7),
-            ("rolling_disc", 0x1877c15866735719, 7),
-            ("cart_pendulum_pid", 0xd3e3bd3cc93e9528, 7),
-            ("benchmark_bicycle", 0xfe0a2f9c482cd5a7, 7),
-            ("blade_alpha", 0x42a4f867e4e926e9, 90),
-            ("spring_mass_damper", 0x98ac50cb9f6f4fff, 37),
-            ("torque_free_body", 0x5c3ad88ef6b8f50e, 10),
+            ("rolling_disc", 0x91a21643723c2391, 7),
+            ("cart_pendulum_pid", 0x7d1fcdd1504bc01b, 7),
+            ("benchmark_bicycle", 0x1b3add74170ea8fd, 7),
+            ("blade_alpha", 0x4c8656375228b82a, 90),
+            ("spring_mass_damper", 0xceda7becb5df58d3, 37),
+            ("torque_free_body", 0x235f1eb451628569, 10),
         ];
         for (name, hash, steps) in table {
             let run = || {
@@ -916,14 +918,14 @@ mod tests {
             s.advance(2.0).unwrap();
             (fnv64(&s.snapshot().to_bytes()), vec![s.stats().steps])
         };
-        check("double_pendulum, bounded step", &run, 0x7ec0a7d53d9c0ff0, &[366]);
+        check("double_pendulum, bounded step", &run, 0xfc49e24eab9a8c54, &[366]);
         // A step-size collapse in the toggle position: many rejected steps.
         let run = || {
             let mut s = simulator("tests/models/fourbar_toggle.xml", SimOptions::default());
             assert!(s.advance(2.2).is_err());
             (fnv64(&s.snapshot().to_bytes()), vec![s.stats().steps, s.stats().rejected])
         };
-        check("fourbar_toggle", &run, 0x649347da99abaa5b, &[301, 182]);
+        check("fourbar_toggle", &run, 0x41f8dd8086c50da3, &[301, 182]);
         // The step limit.
         let run = || {
             let mut s = simulator("models/cart_pendulum_pid.xml", SimOptions { max_steps: 50, ..Default::default() });
@@ -931,6 +933,6 @@ mod tests {
             assert!(s.advance(1e6).is_err());
             (fnv64(&s.snapshot().to_bytes()), vec![s.stats().steps])
         };
-        check("cart_pendulum_pid, step limit", &run, 0x053978c542f6d264, &[50]);
+        check("cart_pendulum_pid, step limit", &run, 0xd8e69a61c82d1371, &[50]);
     }
 }
