@@ -659,7 +659,7 @@ mod tests {
             assert_eq!(bits(&y3), bits(&y4), "sparse gemv, n = {n}");
             // A block that needs row interchanges: small diagonal, larger entries below.
             let d: Vec<f64> =
-                (0..n * n).map(|i| if i % (n + 1) == 0 { 0.1 } else { ((i * 53 % 97) as f64 / 48.0 - 1.0) }).collect();
+                (0..n * n).map(|i| if i % (n + 1) == 0 { 0.1 } else { (i * 53 % 97) as f64 / 48.0 - 1.0 }).collect();
             let mut lu = d.clone();
             let mut piv = vec![0; n];
             lu_in_place(&mut lu, n, &mut piv).expect("nonsingular block");
