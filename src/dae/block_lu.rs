@@ -149,7 +149,7 @@ impl<T: LuScalar> BlockLu<T> {
                 let (i0, si) = (s.start[i], size(s, i));
                 let off = s.offs[st.o0 + st.nl + j];
                 let (y, x) = split_two(w, i0..i0 + si, k0..k0 + sk);
-                gemv_sub(y, &a[off..off + si * sk], x);
+                gemv_sub(y, &a[off..off + si * sk], x, false);
             }
         }
         // Backward: w_k ← D_kk⁻¹ (w_k − Σ_j A_kj w_j), D_kk⁻¹ = U⁻¹ L⁻¹ P.
@@ -160,7 +160,7 @@ impl<T: LuScalar> BlockLu<T> {
                 let (g0, sg) = (s.start[g], size(s, g));
                 let off = s.offs[st.o0 + j];
                 let (y, x) = split_two(w, k0..k0 + sk, g0..g0 + sg);
-                gemv_sub(y, &a[off..off + sk * sg], x);
+                gemv_sub(y, &a[off..off + sk * sg], x, false);
             }
             let dg = &a[st.diag..st.diag + sk * sk];
             block_solve(dg, &self.rdiag[k0..k0 + sk], &self.piv[k0..k0 + sk], &mut w[k0..k0 + sk]);
@@ -260,7 +260,7 @@ fn eliminate<T: LuScalar>(
             let oij = offs[2 * st.nl + i * st.nl + j];
             let blk = &mut a[oij..oij + si * sj];
             for (c, out) in blk.chunks_exact_mut(si).enumerate() {
-                gemv_sub_sparse(out, li, &u[(ucol + c) * sk..(ucol + c + 1) * sk]);
+                gemv_sub(out, li, &u[(ucol + c) * sk..(ucol + c + 1) * sk], true);
             }
             ucol += sj;
         }
@@ -300,41 +300,18 @@ macro_rules! by_size {
     };
 }
 
-/// y −= A x for the column-major len(y) × len(x) block `a`.
+/// y −= A x for the column-major len(y) × len(x) block `a`; with `skip_zeros` the
+/// columns of the zero entries of x are not read (structural zeros of a factorization).
 #[inline]
-fn gemv_sub<T: LuScalar>(y: &mut [T], a: &[T], x: &[T]) {
-    by_size!(y.len(), gemv_sub_n, gemv_sub_any, (y, a, x), [1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12]);
+fn gemv_sub<T: LuScalar>(y: &mut [T], a: &[T], x: &[T], skip_zeros: bool) {
+    by_size!(y.len(), gemv_sub_n, gemv_sub_any, (y, a, x, skip_zeros), [1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12]);
 }
 
-fn gemv_sub_n<T: LuScalar, const N: usize>(y: &mut [T], a: &[T], x: &[T]) {
+fn gemv_sub_n<T: LuScalar, const N: usize>(y: &mut [T], a: &[T], x: &[T], skip_zeros: bool) {
     let y: &mut [T; N] = y.try_into().expect("block of N rows");
     let mut acc = *y;
     for (col, &v) in a.chunks_exact(N).zip(x) {
-        let col: &[T; N] = col.try_into().expect("column of N");
-        for r in 0..N {
-            acc[r] -= col[r] * v;
-        }
-    }
-    *y = acc;
-}
-
-fn gemv_sub_any<T: LuScalar>(y: &mut [T], a: &[T], x: &[T]) {
-    for (col, &v) in a.chunks_exact(y.len()).zip(x) {
-        axpy(y, col, v);
-    }
-}
-
-/// [`gemv_sub`], the zero entries of x skipped (structural zeros of a factorization).
-#[inline]
-fn gemv_sub_sparse<T: LuScalar>(y: &mut [T], a: &[T], x: &[T]) {
-    by_size!(y.len(), gemv_sub_sparse_n, gemv_sub_sparse_any, (y, a, x), [1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12]);
-}
-
-fn gemv_sub_sparse_n<T: LuScalar, const N: usize>(y: &mut [T], a: &[T], x: &[T]) {
-    let y: &mut [T; N] = y.try_into().expect("block of N rows");
-    let mut acc = *y;
-    for (col, &v) in a.chunks_exact(N).zip(x) {
-        if v.is_zero() {
+        if skip_zeros && v.is_zero() {
             continue;
         }
         let col: &[T; N] = col.try_into().expect("column of N");
@@ -345,9 +322,9 @@ fn gemv_sub_sparse_n<T: LuScalar, const N: usize>(y: &mut [T], a: &[T], x: &[T])
     *y = acc;
 }
 
-fn gemv_sub_sparse_any<T: LuScalar>(y: &mut [T], a: &[T], x: &[T]) {
+fn gemv_sub_any<T: LuScalar>(y: &mut [T], a: &[T], x: &[T], skip_zeros: bool) {
     for (col, &v) in a.chunks_exact(y.len()).zip(x) {
-        if !v.is_zero() {
+        if !(skip_zeros && v.is_zero()) {
             axpy(y, col, v);
         }
     }
@@ -650,13 +627,13 @@ mod tests {
             let x: Vec<f64> = (0..m).map(|i| if i % 4 == 1 { 0.0 } else { (i as f64 * 0.61).sin() }).collect();
             let y0: Vec<f64> = (0..n).map(|i| (i as f64 * 1.3).cos()).collect();
             let (mut y1, mut y2, mut y3, mut y4) = (y0.clone(), y0.clone(), y0.clone(), y0.clone());
-            gemv_sub(&mut y1, &a, &x);
-            gemv_sub_any(&mut y2, &a, &x);
-            gemv_sub_sparse(&mut y3, &a, &x);
-            gemv_sub_sparse_any(&mut y4, &a, &x);
+            gemv_sub(&mut y1, &a, &x, false);
+            gemv_sub_any(&mut y2, &a, &x, false);
+            gemv_sub(&mut y3, &a, &x, true);
+            gemv_sub_any(&mut y4, &a, &x, true);
             let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
             assert_eq!(bits(&y1), bits(&y2), "gemv, n = {n}");
-            assert_eq!(bits(&y3), bits(&y4), "sparse gemv, n = {n}");
+            assert_eq!(bits(&y3), bits(&y4), "gemv skipping zeros, n = {n}");
             // A block that needs row interchanges: small diagonal, larger entries below.
             let d: Vec<f64> =
                 (0..n * n).map(|i| if i % (n + 1) == 0 { 0.1 } else { (i * 53 % 97) as f64 / 48.0 - 1.0 }).collect();

@@ -852,8 +852,9 @@ mod tests {
     /// same engine state bit for bit; and where the arithmetic is the recording machine's,
     /// in the states and step counts recorded at the last intended numerical change (a
     /// slow Newton iteration refreshes J within the step, held steps converge tighter,
-    /// the iteration matrix leaves out the cross-body constraint Hessian, the block LU keeps
-    /// its row blocks and divides by no pivot in a solve: issue 26, 2026-12-07). Update the table only for an intended numerical change.
+    /// the iteration matrix leaves out the cross-body constraint Hessian, the block LU
+    /// keeps its row blocks and divides by no pivot in a solve: issue 26, 2026-12-07).
+    /// Update the table only for an intended numerical change.
     ///
     /// faer's dense kernels choose their SIMD path and blocking at run time (instruction
     /// set, cache sizes), and another choice rounds differently; so the recorded bits are
