@@ -126,9 +126,16 @@ impl<T: LuScalar> BlockLu<T> {
         for (&k, &v) in s.slot.iter().zip(vals) {
             self.arena[k] += v;
         }
-        for st in &s.steps {
-            eliminate(s, st, &mut self.arena, &mut self.piv, &mut self.rdiag, &mut self.scratch)?;
+        let (a, piv, rdiag, scratch) = (&mut self.arena, &mut self.piv, &mut self.rdiag, &mut self.scratch);
+        #[cfg(target_arch = "x86_64")]
+        if wide_vectors() {
+            // SAFETY: the CPU has AVX2 (`wide_vectors`).
+            unsafe { eliminate_all_avx2(s, a, piv, rdiag, scratch)? }
+        } else {
+            eliminate_all(s, a, piv, rdiag, scratch)?;
         }
+        #[cfg(not(target_arch = "x86_64"))]
+        eliminate_all(s, a, piv, rdiag, scratch)?;
         self.factored = true;
         Ok(())
     }
@@ -137,41 +144,102 @@ impl<T: LuScalar> BlockLu<T> {
     /// finite.
     pub fn solve(&mut self, b: &mut [T]) -> bool {
         let Some(s) = self.sym.as_ref().filter(|_| self.factored) else { return false };
-        let (a, w) = (&self.arena, &mut self.w);
-        for (p, &v) in s.vars.iter().enumerate() {
-            w[p] = b[v];
+        let (a, rdiag, piv, w) = (&self.arena[..], &self.rdiag[..], &self.piv[..], &mut self.w[..]);
+        #[cfg(target_arch = "x86_64")]
+        if wide_vectors() {
+            // SAFETY: the CPU has AVX2 (`wide_vectors`).
+            unsafe { solve_in_avx2(s, a, rdiag, piv, w, b) }
+        } else {
+            solve_in(s, a, rdiag, piv, w, b);
         }
-        // Forward: w_i −= L_ik w_k for the groups still present after k.
-        for st in &s.steps {
-            let (k0, sk) = (s.start[st.k], size(s, st.k));
-            for j in 0..st.nl {
-                let i = s.later[st.l0 + j];
-                let (i0, si) = (s.start[i], size(s, i));
-                let off = s.offs[st.o0 + st.nl + j];
-                let (y, x) = split_two(w, i0..i0 + si, k0..k0 + sk);
-                gemv_sub(y, &a[off..off + si * sk], x, false);
-            }
-        }
-        // Backward: w_k ← D_kk⁻¹ (w_k − Σ_j A_kj w_j), D_kk⁻¹ = U⁻¹ L⁻¹ P.
-        for st in s.steps.iter().rev() {
-            let (k0, sk) = (s.start[st.k], size(s, st.k));
-            for j in 0..st.nl {
-                let g = s.later[st.l0 + j];
-                let (g0, sg) = (s.start[g], size(s, g));
-                let off = s.offs[st.o0 + j];
-                let (y, x) = split_two(w, k0..k0 + sk, g0..g0 + sg);
-                gemv_sub(y, &a[off..off + sk * sg], x, false);
-            }
-            let dg = &a[st.diag..st.diag + sk * sk];
-            block_solve(dg, &self.rdiag[k0..k0 + sk], &self.piv[k0..k0 + sk], &mut w[k0..k0 + sk]);
-        }
-        for (p, &v) in s.vars.iter().enumerate() {
-            b[v] = w[p];
-        }
+        #[cfg(not(target_arch = "x86_64"))]
+        solve_in(s, a, rdiag, piv, w, b);
         b.iter().all(|v| v.finite())
     }
 }
 
+/// Whether the kernels run in their AVX2 build (4 lanes instead of SSE2's 2; read once
+/// per factorization or solve from the CPU, cached by `std`). Without FMA the arithmetic
+/// and its rounding are those of the baseline build, so a run gives the same bits on
+/// every x86-64 machine.
+#[cfg(target_arch = "x86_64")]
+#[inline]
+fn wide_vectors() -> bool {
+    std::arch::is_x86_feature_detected!("avx2")
+}
+
+/// Every elimination step of the numeric factorization, in order.
+#[inline(always)]
+fn eliminate_all<T: LuScalar>(
+    s: &Symbolic,
+    a: &mut [T],
+    piv: &mut [usize],
+    rdiag: &mut [T],
+    scratch: &mut Scratch<T>,
+) -> Result<(), String> {
+    for st in &s.steps {
+        eliminate(s, st, a, piv, rdiag, scratch)?;
+    }
+    Ok(())
+}
+
+/// [`eliminate_all`] compiled for AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn eliminate_all_avx2<T: LuScalar>(
+    s: &Symbolic,
+    a: &mut [T],
+    piv: &mut [usize],
+    rdiag: &mut [T],
+    scratch: &mut Scratch<T>,
+) -> Result<(), String> {
+    eliminate_all(s, a, piv, rdiag, scratch)
+}
+
+/// The forward and backward sweeps of a solve of the factorization (`a`, `rdiag`,
+/// `piv`) in the work vector `w`, b in place.
+#[inline(always)]
+fn solve_in<T: LuScalar>(s: &Symbolic, a: &[T], rdiag: &[T], piv: &[usize], w: &mut [T], b: &mut [T]) {
+    for (p, &v) in s.vars.iter().enumerate() {
+        w[p] = b[v];
+    }
+    // Forward: w_i −= L_ik w_k for the groups still present after k.
+    for st in &s.steps {
+        let (k0, sk) = (s.start[st.k], size(s, st.k));
+        for j in 0..st.nl {
+            let i = s.later[st.l0 + j];
+            let (i0, si) = (s.start[i], size(s, i));
+            let off = s.offs[st.o0 + st.nl + j];
+            let (y, x) = split_two(w, i0..i0 + si, k0..k0 + sk);
+            gemv_sub(y, &a[off..off + si * sk], x, false);
+        }
+    }
+    // Backward: w_k ← D_kk⁻¹ (w_k − Σ_j A_kj w_j), D_kk⁻¹ = U⁻¹ L⁻¹ P.
+    for st in s.steps.iter().rev() {
+        let (k0, sk) = (s.start[st.k], size(s, st.k));
+        for j in 0..st.nl {
+            let g = s.later[st.l0 + j];
+            let (g0, sg) = (s.start[g], size(s, g));
+            let off = s.offs[st.o0 + j];
+            let (y, x) = split_two(w, k0..k0 + sk, g0..g0 + sg);
+            gemv_sub(y, &a[off..off + sk * sg], x, false);
+        }
+        let dg = &a[st.diag..st.diag + sk * sk];
+        block_solve(dg, &rdiag[k0..k0 + sk], &piv[k0..k0 + sk], &mut w[k0..k0 + sk]);
+    }
+    for (p, &v) in s.vars.iter().enumerate() {
+        b[v] = w[p];
+    }
+}
+
+/// [`solve_in`] compiled for AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn solve_in_avx2<T: LuScalar>(s: &Symbolic, a: &[T], rdiag: &[T], piv: &[usize], w: &mut [T], b: &mut [T]) {
+    solve_in(s, a, rdiag, piv, w, b);
+}
+
+#[inline(always)]
 fn size(s: &Symbolic, g: usize) -> usize {
     s.start[g + 1] - s.start[g]
 }
@@ -181,6 +249,7 @@ fn size(s: &Symbolic, g: usize) -> usize {
 /// checked, the reciprocals of U's diagonal kept), its L column blocks L_ik = A_ik D_kk⁻¹
 /// and the Schur updates A_ij −= L_ik A_kj of the groups still present. The forward
 /// solve is then one product per block, and no solve divides.
+#[inline(always)]
 fn eliminate<T: LuScalar>(
     s: &Symbolic,
     st: &Step,
@@ -270,7 +339,7 @@ fn eliminate<T: LuScalar>(
 }
 
 /// y −= x·a.
-#[inline]
+#[inline(always)]
 fn axpy<T: LuScalar>(y: &mut [T], x: &[T], a: T) {
     for (o, &v) in y.iter_mut().zip(x) {
         *o -= v * a;
@@ -278,7 +347,7 @@ fn axpy<T: LuScalar>(y: &mut [T], x: &[T], a: T) {
 }
 
 /// The disjoint ranges `y` (mutable) and `x` of `w`.
-#[inline]
+#[inline(always)]
 fn split_two<T>(w: &mut [T], y: Range<usize>, x: Range<usize>) -> (&mut [T], &[T]) {
     if y.start >= x.end {
         let (lo, hi) = w.split_at_mut(y.start);
@@ -302,11 +371,12 @@ macro_rules! by_size {
 
 /// y −= A x for the column-major len(y) × len(x) block `a`; with `skip_zeros` the
 /// columns of the zero entries of x are not read (structural zeros of a factorization).
-#[inline]
+#[inline(always)]
 fn gemv_sub<T: LuScalar>(y: &mut [T], a: &[T], x: &[T], skip_zeros: bool) {
     by_size!(y.len(), gemv_sub_n, gemv_sub_any, (y, a, x, skip_zeros), [1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12]);
 }
 
+#[inline(always)]
 fn gemv_sub_n<T: LuScalar, const N: usize>(y: &mut [T], a: &[T], x: &[T], skip_zeros: bool) {
     let y: &mut [T; N] = y.try_into().expect("block of N rows");
     let mut acc = *y;
@@ -322,6 +392,7 @@ fn gemv_sub_n<T: LuScalar, const N: usize>(y: &mut [T], a: &[T], x: &[T], skip_z
     *y = acc;
 }
 
+#[inline(always)]
 fn gemv_sub_any<T: LuScalar>(y: &mut [T], a: &[T], x: &[T], skip_zeros: bool) {
     for (col, &v) in a.chunks_exact(y.len()).zip(x) {
         if !(skip_zeros && v.is_zero()) {
@@ -332,11 +403,12 @@ fn gemv_sub_any<T: LuScalar>(y: &mut [T], a: &[T], x: &[T], skip_zeros: bool) {
 
 /// x ← D⁻¹ x = U⁻¹ L⁻¹ P x for the LU `lu` of a diagonal block (column-major, as
 /// [`lu_in_place`] leaves it) with row interchanges `piv` and U's reciprocal pivots `rd`.
-#[inline]
+#[inline(always)]
 fn block_solve<T: LuScalar>(lu: &[T], rd: &[T], piv: &[usize], x: &mut [T]) {
     by_size!(x.len(), block_solve_n, block_solve_any, (lu, rd, piv, x), [1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12]);
 }
 
+#[inline(always)]
 fn block_solve_n<T: LuScalar, const N: usize>(lu: &[T], rd: &[T], piv: &[usize], x: &mut [T]) {
     let xs: &mut [T; N] = x.try_into().expect("block of N");
     let mut v = *xs;
@@ -359,6 +431,7 @@ fn block_solve_n<T: LuScalar, const N: usize>(lu: &[T], rd: &[T], piv: &[usize],
     *xs = v;
 }
 
+#[inline(always)]
 fn block_solve_any<T: LuScalar>(lu: &[T], rd: &[T], piv: &[usize], x: &mut [T]) {
     let s = x.len();
     for (c, &p) in piv.iter().enumerate() {
@@ -377,6 +450,7 @@ fn block_solve_any<T: LuScalar>(lu: &[T], rd: &[T], piv: &[usize], x: &mut [T]) 
 
 /// Dense LU with partial pivoting of the column-major s×s matrix `d` in place
 /// (unit L below, U on and above the diagonal); `piv[c]` is the row swapped with row c.
+#[inline(always)]
 fn lu_in_place<T: LuScalar>(d: &mut [T], s: usize, piv: &mut [usize]) -> Result<(), String> {
     for c in 0..s {
         // The column's largest entry before elimination: a pivot is small against its
@@ -651,6 +725,43 @@ mod tests {
                 assert!((dx - b[r]).abs() < 1e-13 * (1.0 + x1.iter().fold(0.0f64, |m, v| m.max(v.abs()))), "n = {n}");
             }
         }
+    }
+
+    /// The factorization and solve of the CPU's build (AVX2 where it has it) give the
+    /// bits of the baseline build, real and complex: a run does not depend on the
+    /// machine's vector width.
+    #[test]
+    fn the_wide_vector_build_gives_the_baseline_bits() {
+        fn check<T: LuScalar + std::fmt::Debug>(to: impl Fn(usize, f64) -> T, bits: impl Fn(&[T]) -> Vec<u64>) {
+            let (n, idx, vals, groups) = chain(25, true);
+            let vals: Vec<T> = vals.iter().enumerate().map(|(i, &v)| to(i, v)).collect();
+            let mut blu = BlockLu::<T>::default();
+            blu.factor(n, &idx, &vals, &groups).expect("block LU");
+            let b: Vec<T> = (0..n).map(|i| to(i + 7, (i as f64 * 0.37).sin())).collect();
+            let mut x = b.clone();
+            assert!(blu.solve(&mut x));
+            // The baseline build of the numeric factorization, from the same entries.
+            let s = blu.sym.as_ref().expect("analysed");
+            let mut a = vec![<T as LuScalar>::zero(); s.arena];
+            for (&k, &v) in s.slot.iter().zip(&vals) {
+                a[k] += v;
+            }
+            let (mut piv, mut rdiag) = (vec![0; n], vec![<T as LuScalar>::zero(); n]);
+            let zero = <T as LuScalar>::zero();
+            let big = blu.scratch.d.len().max(blu.scratch.u.len()).max(blu.scratch.l.len());
+            let mut scratch = Scratch { d: vec![zero; big], u: vec![zero; big], l: vec![zero; big] };
+            eliminate_all(s, &mut a, &mut piv, &mut rdiag, &mut scratch).expect("baseline factorization");
+            assert_eq!(bits(&a), bits(&blu.arena), "factors");
+            assert_eq!(piv, blu.piv);
+            let (mut xb, mut w) = (b.clone(), vec![zero; n]);
+            solve_in(s, &a, &rdiag, &piv, &mut w, &mut xb);
+            assert_eq!(bits(&xb), bits(&x), "solution");
+        }
+        check(|_, v| v, |v: &[f64]| v.iter().map(|x| x.to_bits()).collect());
+        check(
+            |i, v| c64::new(v, 0.3 * (i as f64).cos()),
+            |v: &[c64]| v.iter().flat_map(|x| [x.re.to_bits(), x.im.to_bits()]).collect(),
+        );
     }
 
     #[test]
