@@ -63,6 +63,9 @@ struct RowBuffers {
     rates: BodyRates,
     /// (Pᵀλ)_q, local.
     lq: Vec<f64>,
+    /// The element's gradients and Hessians weighted by λ and summed.
+    gsum: Vec<f64>,
+    hsum: Vec<f64>,
     /// A P row, a Hessian column and its Hᵀ product.
     p: Vec<f64>,
     col: Vec<f64>,
@@ -252,6 +255,12 @@ fn constraint_rows(at: &At, within_bodies: bool, ws: &mut RowBuffers, jac: &mut 
         body_rates_into(at.sys, &el.bodies, at.q, at.u, &mut ws.local, &mut ws.rates);
         ws.lq.clear();
         ws.lq.resize(nql * nql, 0.0);
+        // Σ_e λ_e ∇C_e and Σ_e λ_e ∇²C_e: (Pᵀλ)_q is linear in them.
+        ws.gsum.clear();
+        ws.gsum.resize(k, 0.0);
+        ws.hsum.clear();
+        ws.hsum.resize(k * k, 0.0);
+        let mut any = false;
         for e in 0..el.neq {
             let row = el.row + e;
             if at.sys.redundant[row] {
@@ -264,8 +273,13 @@ fn constraint_rows(at: &At, within_bodies: bool, ws: &mut RowBuffers, jac: &mut 
             let hs = &s.hess[e * k * k..(e + 1) * k * k];
             constraint_row(at, &el.bodies, row, g, hs, &ws.rates, &mut ws.p, jac);
             if lam != 0.0 {
-                add_pt_lambda_q(at, &el.bodies, lam, g, hs, (&mut ws.col, &mut ws.ht), &mut ws.lq);
+                any = true;
+                ws.gsum.iter_mut().zip(g).for_each(|(o, v)| *o += lam * v);
+                ws.hsum.iter_mut().zip(hs).for_each(|(o, v)| *o += lam * v);
             }
+        }
+        if any {
+            add_pt_lambda_q(at, &el.bodies, &ws.gsum, &ws.hsum, (&mut ws.col, &mut ws.ht), &mut ws.lq);
         }
         push_pt_lambda_q(at, &el.bodies, &ws.lq, within_bodies, jac);
     }
@@ -328,13 +342,12 @@ fn constraint_row(
     }
 }
 
-/// Add one equation's (Pᵀλ)_q = λ [Hᵀ ∂C_q/∂q + ∂(Hᵀ w)/∂q |_{w = C_q}] to `lq` (local,
-/// row-major nql × nql), from its gradient `g` and Hessian `hs` (`bufs`: two buffers).
-#[allow(clippy::too_many_arguments)]
+/// Add an element's (Pᵀλ)_q = Hᵀ ∂(C_qᵀλ)/∂q + ∂(Hᵀ w)/∂q |_{w = C_qᵀλ} to `lq` (local,
+/// row-major nql × nql), from its equations' gradients and Hessians weighted by their λ
+/// and summed, `g` and `hs` (`bufs`: two buffers).
 fn add_pt_lambda_q(
     at: &At,
     bodies: &[usize],
-    lam: f64,
     g: &[f64],
     hs: &[f64],
     bufs: (&mut Vec<f64>, &mut Vec<f64>),
@@ -348,14 +361,14 @@ fn add_pt_lambda_q(
         col.extend((0..nql).map(|c| hs[c * k + a]));
         p_row_into(bodies, |b| at.h[b], col, ht);
         for r in 0..nql {
-            lq[r * nql + a] += lam * ht[r];
+            lq[r * nql + a] += ht[r];
         }
     }
     for (kb, &b) in bodies.iter().enumerate() {
         let d = dhtw_dq(&q[NQ * b..NQ * b + NQ], &g[NQ * kb..NQ * kb + NQ]);
         for r in 0..NQ {
             for c in 0..NQ {
-                lq[(NQ * kb + r) * nql + NQ * kb + c] += lam * d[r * 6 + c];
+                lq[(NQ * kb + r) * nql + NQ * kb + c] += d[r * 6 + c];
             }
         }
     }
