@@ -22,6 +22,23 @@ use std::ops::Range;
 /// pivoting then takes the matrix).
 pub const PIVOT_TOL: f64 = 1e-12;
 
+/// `$wide $args` (a kernel's AVX2 build) where the CPU has AVX2 ([`wide_vectors`]), else
+/// `$base $args` (the baseline build).
+macro_rules! wide_or_baseline {
+    ($wide:ident, $base:ident, $args:tt) => {{
+        #[cfg(target_arch = "x86_64")]
+        let r = if wide_vectors() {
+            // SAFETY: the CPU has AVX2 (`wide_vectors`).
+            unsafe { $wide $args }
+        } else {
+            $base $args
+        };
+        #[cfg(not(target_arch = "x86_64"))]
+        let r = $base $args;
+        r
+    }};
+}
+
 /// Scratch of an elimination step: its diagonal block, its row blocks side by side,
 /// its L column blocks one after the other.
 struct Scratch<T> {
@@ -127,15 +144,7 @@ impl<T: LuScalar> BlockLu<T> {
             self.arena[k] += v;
         }
         let (a, piv, rdiag, scratch) = (&mut self.arena, &mut self.piv, &mut self.rdiag, &mut self.scratch);
-        #[cfg(target_arch = "x86_64")]
-        if wide_vectors() {
-            // SAFETY: the CPU has AVX2 (`wide_vectors`).
-            unsafe { eliminate_all_avx2(s, a, piv, rdiag, scratch)? }
-        } else {
-            eliminate_all(s, a, piv, rdiag, scratch)?;
-        }
-        #[cfg(not(target_arch = "x86_64"))]
-        eliminate_all(s, a, piv, rdiag, scratch)?;
+        wide_or_baseline!(eliminate_all_avx2, eliminate_all, (s, a, piv, rdiag, scratch))?;
         self.factored = true;
         Ok(())
     }
@@ -145,15 +154,7 @@ impl<T: LuScalar> BlockLu<T> {
     pub fn solve(&mut self, b: &mut [T]) -> bool {
         let Some(s) = self.sym.as_ref().filter(|_| self.factored) else { return false };
         let (a, rdiag, piv, w) = (&self.arena[..], &self.rdiag[..], &self.piv[..], &mut self.w[..]);
-        #[cfg(target_arch = "x86_64")]
-        if wide_vectors() {
-            // SAFETY: the CPU has AVX2 (`wide_vectors`).
-            unsafe { solve_in_avx2(s, a, rdiag, piv, w, b) }
-        } else {
-            solve_in(s, a, rdiag, piv, w, b);
-        }
-        #[cfg(not(target_arch = "x86_64"))]
-        solve_in(s, a, rdiag, piv, w, b);
+        wide_or_baseline!(solve_in_avx2, solve_in, (s, a, rdiag, piv, w, b));
         b.iter().all(|v| v.finite())
     }
 }
