@@ -327,15 +327,14 @@ fn constraint_row(
         jac.push(ga, nm + row, -g[a]);
         jac.push(nu + ga, nl + row, -p[a]);
         jac.push(nm + row, nu + ga, p[a]);
-        // Ċ_q = Σ_c C_qc,qa q̇_c + C_q ∂q̇/∂q_a + C_t,qa (a modal rate η̇ does not depend on q).
-        let kb = a / NQ;
-        let mut v = hs[a * k + nql];
-        for c in 0..nql {
-            v += hs[c * k + a] * rates.qd[c];
-        }
-        if kb < bodies.len() {
-            for c in 0..NQ {
-                v += g[NQ * kb + c] * rates.dq[kb][c * 6 + a % NQ];
+        // Ċ_q = Σ_c C_qc,qa q̇_c + C_q ∂q̇/∂q_a + C_t,qa (row a of the symmetric Hessian; a
+        // modal rate η̇ does not depend on q).
+        let (kb, ha) = (a / NQ, &hs[a * k..(a + 1) * k]);
+        let mut v = ha[..nql].iter().zip(&rates.qd[..nql]).fold(ha[nql], |v, (h, d)| v + h * d);
+        if let Some(dq) = rates.dq.get(kb) {
+            let col = a % NQ;
+            for (c, gc) in g[NQ * kb..NQ * kb + NQ].iter().enumerate() {
+                v += gc * dq[c * 6 + col];
             }
         }
         jac.push(nm + row, ga, v);

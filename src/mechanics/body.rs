@@ -70,6 +70,33 @@ impl<T: Real> Turn<T> {
     }
 }
 
+/// The second derivatives ∂²A/∂e_m∂e_n of a body's rotation A = R0 · Rz(ψ)Rx(θ)Rz(φ) by
+/// its Euler angles e = (ψ, θ, φ) (symmetric in m, n). With E as in [`Turn::of`]
+/// (E² = −diag(1, 1, 0)): R_ψψ = E²R, R_φφ = RE², R_ψφ = ERE, R_ψθ = E R_θ, R_θφ = R_θ E,
+/// and R_θθ = −R + (Rz(ψ) x)(Rz(φ)ᵀ x)ᵀ (x the first axis: Rx'' = −Rx + x xᵀ).
+pub fn rotation_second(r0: &[[f64; 3]; 3], e: &[f64]) -> [[M3<f64>; 3]; 3] {
+    let s: [f64; 3] = std::array::from_fn(|k| e[k].sin());
+    let c: [f64; 3] = std::array::from_fn(|k| e[k].cos());
+    let r = rot313_sc(s, c).0;
+    let ([s1, s2, s3], [c1, c2, c3]) = (s, c);
+    let rt = [
+        [s1 * s2 * s3, s1 * s2 * c3, s1 * c2],
+        [-(c1 * s2 * s3), -(c1 * s2 * c3), -(c1 * c2)],
+        [c2 * s3, c2 * c3, -s2],
+    ];
+    // E M: rows (−M₁, M₀, 0); M E: columns (M·₁, −M·₀, 0).
+    let el = |m: &[[f64; 3]; 3]| [[-m[1][0], -m[1][1], -m[1][2]], m[0], [0.0; 3]];
+    let er = |m: &[[f64; 3]; 3]| std::array::from_fn(|i| [m[i][1], -m[i][0], 0.0]);
+    let (u, v) = ([c1, s1, 0.0], [c3, -s3, 0.0]);
+    let tt: [[f64; 3]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| u[i] * v[j] - r[i][j]));
+    let (pp, ff, pf) = (el(&el(&r)), er(&er(&r)), el(&er(&r)));
+    let (pt, tf) = (el(&rt), er(&rt));
+    let r0 = M3::cst(r0);
+    let a = |m: [[f64; 3]; 3]| r0.mm(&M3(m));
+    let (pp, pt, pf, tt, tf, ff) = (a(pp), a(pt), a(pf), a(tt), a(tf), a(ff));
+    [[pp, pt, pf], [pt, tt, tf], [pf, tf, ff]]
+}
+
 /// The [`Turn`] of every body at global q (six coordinates per body; `r0`: the bodies'
 /// reference frames), into `out` (its capacity reused).
 pub fn body_turns(r0: &[[[f64; 3]; 3]], q: &[f64], out: &mut Vec<Turn<f64>>) {

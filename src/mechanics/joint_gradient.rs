@@ -4,43 +4,20 @@
 //! where the general dual-number kernels ([`super::kernels::constraint_first_ad`],
 //! nested duals for the Hessians) carry 13 (or 13 × 13) derivative lanes through every
 //! operation. Here each body's rotation and its three partial derivatives are formed once
-//! and the gradient is written out; the Hessians are that gradient differentiated by
-//! dual numbers over the element's 6 or 12 coordinates. The equations are those of
+//! and the gradient is written out; the Hessians come from [`super::joint_hessian`], in
+//! closed form too. The equations are those of
 //! [`super::constraint_equations`] (the model format's joint table); a test holds the
 //! two to round-off.
 
 use super::body::{NQ, Turn};
-use super::constraints::{ConstraintEl, ConstraintKind};
+use super::constraints::ConstraintEl;
+#[cfg(test)]
 use super::coords::nql;
+use super::joint_table::{Row, equations, rigid_joint};
 use super::system::System;
-use crate::ad::{Dual, Real};
+use crate::ad::Real;
 use crate::geom::{M3, V3};
 use crate::model::JointType;
-
-/// One equation of a joint, over the marker frames i and j and d = p_i − p_j.
-#[derive(Clone, Copy)]
-enum Row {
-    /// Component c of d.
-    D(usize),
-    /// Axis a of marker i · axis b of marker j.
-    Axes(usize, usize),
-    /// d · axis b of marker j.
-    DAxis(usize),
-}
-
-/// The equations of each joint type, in the order of the model format's table.
-fn equations(kind: JointType) -> &'static [Row] {
-    use Row::*;
-    match kind {
-        JointType::Fixed => &[D(0), D(1), D(2), Axes(2, 0), Axes(2, 1), Axes(0, 1)],
-        JointType::Revolute => &[D(0), D(1), D(2), Axes(2, 0), Axes(2, 1)],
-        JointType::Translational => &[Axes(2, 0), Axes(2, 1), Axes(0, 1), DAxis(0), DAxis(1)],
-        JointType::Cylindrical => &[Axes(2, 0), Axes(2, 1), DAxis(0), DAxis(1)],
-        JointType::Universal => &[D(0), D(1), D(2), Axes(2, 2)],
-        JointType::Spherical => &[D(0), D(1), D(2)],
-        JointType::Planar => &[Axes(2, 0), Axes(2, 1), DAxis(2)],
-    }
-}
 
 /// A marker in ground: position, axes, and their derivatives by its body's Euler angles.
 struct Frame<T: Real> {
@@ -123,15 +100,6 @@ impl<T: Real> Frame<T> {
     }
 }
 
-/// The markers (i, j) and type of `el` when it is a joint whose markers are on rigid
-/// bodies or ground (None: flexible nodes, other constraints).
-fn rigid_joint(sys: &System, el: &ConstraintEl) -> Option<(usize, usize, JointType)> {
-    let ConstraintKind::Joint { kind, i, j } = &el.kind else { return None };
-    let rigid = nql(sys, &el.bodies) == NQ * el.bodies.len();
-    let nodes = sys.markers[*i].node.is_some() || sys.markers[*j].node.is_some();
-    (rigid && !nodes && equations(*kind).len() == el.neq).then_some((*i, *j, *kind))
-}
-
 /// C and C_q (row-major neq × nq, into `c` and `cq`) of a rigid joint with marker frames
 /// `fi`, `fj`.
 fn rows<T: Real>(kind: JointType, fi: &Frame<T>, fj: &Frame<T>, c: &mut [T], cq: &mut [T]) {
@@ -191,72 +159,4 @@ pub fn joint_first_into(
     let (fi, fj) = (Frame::new(sys, el, i, qb, turns), Frame::new(sys, el, j, qb, turns));
     rows(kind, &fi, &fj, c, cq);
     true
-}
-
-/// C, its gradient (neq × k) and Hessians (neq × k × k) over z = (local q, t), k = nq + 1
-/// (the t entries are zero).
-pub type Second = (Vec<f64>, Vec<f64>, Vec<f64>);
-
-/// The [`Second`] derivatives of `el` when it is a joint whose markers are on rigid
-/// bodies or ground, between at most two bodies; None otherwise.
-pub fn joint_second(sys: &System, el: &ConstraintEl, q: &[f64]) -> Option<Second> {
-    let (mut c, mut grad, mut hess) = (Vec::new(), Vec::new(), Vec::new());
-    joint_second_into(sys, el, q, &mut c, &mut grad, &mut hess).then_some((c, grad, hess))
-}
-
-/// Most equations of a joint (a fixed joint's six).
-const MAX_EQ: usize = 6;
-
-/// [`joint_second`] into `c`, `grad` and `hess` (resized, capacities reused; global
-/// `q`); false (nothing written) when `el` is not such a joint.
-pub fn joint_second_into(
-    sys: &System,
-    el: &ConstraintEl,
-    q: &[f64],
-    c: &mut Vec<f64>,
-    grad: &mut Vec<f64>,
-    hess: &mut Vec<f64>,
-) -> bool {
-    let Some(joint) = rigid_joint(sys, el) else { return false };
-    match nql(sys, &el.bodies) {
-        6 => second::<6>(sys, el, joint, q, c, grad, hess),
-        12 => second::<12>(sys, el, joint, q, c, grad, hess),
-        _ => return false,
-    }
-    true
-}
-
-fn second<const K: usize>(
-    sys: &System,
-    el: &ConstraintEl,
-    joint: (usize, usize, JointType),
-    q: &[f64],
-    c_out: &mut Vec<f64>,
-    grad: &mut Vec<f64>,
-    hess: &mut Vec<f64>,
-) {
-    let (nq, k, neq) = (K, K + 1, el.neq);
-    assert!(neq <= MAX_EQ, "a joint has at most {MAX_EQ} equations");
-    // Local coordinate a is global NQ·bodies[a / NQ] + a % NQ (rigid bodies), seeded.
-    let x: [Dual<f64, K>; K] = std::array::from_fn(|a| Dual::var(q[NQ * el.bodies[a / NQ] + a % NQ], a));
-    let (i, j, kind) = joint;
-    let qb = |k: usize| &x[NQ * k..NQ * k + NQ];
-    let (fi, fj) = (Frame::new(sys, el, i, qb, None), Frame::new(sys, el, j, qb, None));
-    let (mut c, mut cq) = ([Dual::<f64, K>::zero(); MAX_EQ], [[Dual::<f64, K>::zero(); K]; MAX_EQ]);
-    rows(kind, &fi, &fj, &mut c[..neq], cq[..neq].as_flattened_mut());
-    grad.clear();
-    grad.resize(neq * k, 0.0);
-    hess.clear();
-    hess.resize(neq * k * k, 0.0);
-    for e in 0..neq {
-        for a in 0..nq {
-            let g = &cq[e][a];
-            grad[e * k + a] = g.v;
-            for b in 0..nq {
-                hess[e * k * k + a * k + b] = g.d[b];
-            }
-        }
-    }
-    c_out.clear();
-    c_out.extend(c[..neq].iter().map(|v| v.v));
 }

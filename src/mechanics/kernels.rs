@@ -6,11 +6,11 @@ use super::body::{Turn, h_transpose_times, qdot};
 use super::constraints::ConstraintEl;
 use super::coords::{gather, gather_into, nql};
 use super::forces::ForceEl;
-use super::joint_gradient;
 use super::local::LocalCtx;
 use super::nonholonomic::NonholonomicEl;
 use super::system::System;
 use super::user::UserEq;
+use super::{joint_gradient, joint_hessian};
 use crate::ad::chunked::{by_width, chunks, seed, seed_one};
 use crate::ad::{Dual, Real};
 use crate::geom::{M3, V3};
@@ -131,7 +131,7 @@ fn first_k<const K: usize>(
 }
 
 /// Second derivatives of a constraint element (for Ċ_q, (Pᵀλ)_q and the γ of Eq. 1c).
-/// Joints between rigid bodies take the closed-form gradient of [`super::joint_gradient`].
+/// Joints between rigid bodies take the closed forms of [`super::joint_hessian`].
 pub fn constraint_second(sys: &System, el: &ConstraintEl, q: &[f64], t: f64, inputs: &[f64]) -> ConstraintSecond {
     let mut r = ConstraintSecond::default();
     constraint_second_into(sys, el, q, t, inputs, &mut r);
@@ -148,7 +148,7 @@ pub fn constraint_second_into(
     inputs: &[f64],
     r: &mut ConstraintSecond,
 ) {
-    if joint_gradient::joint_second_into(sys, el, q, &mut r.c, &mut r.grad, &mut r.hess) {
+    if joint_hessian::joint_second_into(sys, el, q, &mut r.c, &mut r.grad, &mut r.hess) {
         r.k = nql(sys, &el.bodies) + 1;
     } else {
         *r = constraint_second_ad(sys, el, q, t, inputs);
@@ -552,7 +552,8 @@ fn user_qu_k<const K: usize>(
 #[cfg(test)]
 mod joint_tests {
     use super::*;
-    use crate::mechanics::joint_gradient::{joint_first, joint_second};
+    use crate::mechanics::joint_gradient::joint_first;
+    use crate::mechanics::joint_hessian::joint_second;
 
     /// Every joint type of the model format, between two bodies at random poses and to
     /// ground, agrees with the dual-number kernels to round-off: C, C_q and the Hessians

@@ -22,7 +22,11 @@
 //! - [`constraint_equations`]: equations C of the constraint elements and velocity ICs.
 //! - [`force_laws`]: loads and generalized forces of the force elements.
 //! - [`user_rows`]: residuals of the user rows.
-//! - [`kernels`]: exact derivatives of the element equations (forward-mode AD).
+//! - [`joint_table`]: the equations of each joint type over its marker frames.
+//! - [`joint_gradient`]: C and C_q of a joint between rigid bodies in closed form.
+//! - [`joint_hessian`]: its Hessians in closed form.
+//! - [`kernels`]: exact derivatives of the element equations (forward-mode AD; rigid
+//!   joints through the two files above).
 //! - [`loads`]: element loads `fx(name)` … and their exact gradients.
 //! - [`external_values`]: [`System::ext`], the external values at a state.
 //! - [`components`]: connected components of the mechanism.
@@ -47,6 +51,8 @@ pub mod forces;
 pub mod from_model;
 pub mod joint_coords;
 pub mod joint_gradient;
+pub mod joint_hessian;
+pub mod joint_table;
 pub mod kernels;
 pub mod load_components;
 pub mod loads;
