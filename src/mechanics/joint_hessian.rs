@@ -1,6 +1,6 @@
 //! C, its gradient and its Hessians of a joint between markers on rigid bodies (or
 //! ground) in closed form, for the Jacobian's Ċ_q and (Pᵀλ)_q. Every equation of the
-//! joint table ([`super::joint_gradient`]) is a sum of dot products x · y of marker-frame
+//! joint table ([`super::joint_table`]) is a sum of dot products x · y of marker-frame
 //! vectors, each of which is a body's position (linear in its coordinates), a vector
 //! A w fixed in a body (a function of its Euler angles only, second derivatives from
 //! [`rotation_second`]) or a constant (ground, a unit vector); the product rule gives the
