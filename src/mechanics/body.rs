@@ -34,6 +34,17 @@ fn h_angular_sc<T: Real>(s2: T, c2: T, s3: T, c3: T) -> M3<T> {
     M3([[s3 / s2, c3 / s2, z], [c3, -s3, z], [-(c2 * s3) / s2, -(c2 * c3) / s2, T::one()]])
 }
 
+/// The sines and cosines of a body's Euler angles `e` = (ψ, θ, φ).
+pub fn sin_cos<T: Real>(e: &[T]) -> ([T; 3], [T; 3]) {
+    (std::array::from_fn(|k| e[k].sin()), std::array::from_fn(|k| e[k].cos()))
+}
+
+/// ∂R/∂θ of R = Rz(ψ)Rx(θ)Rz(φ), written out from the sines `s` and cosines `c`.
+fn d_theta_sc<T: Real>(s: [T; 3], c: [T; 3]) -> M3<T> {
+    let ([s1, s2, s3], [c1, c2, c3]) = (s, c);
+    M3([[s1 * s2 * s3, s1 * s2 * c3, s1 * c2], [-(c1 * s2 * s3), -(c1 * s2 * c3), -(c1 * c2)], [c2 * s3, c2 * c3, -s2]])
+}
+
 /// What a body's Euler angles give, from one sine and cosine of each: its rotation
 /// A = R0 · Rz(ψ)Rx(θ)Rz(φ), the partial derivatives ∂A/∂(ψ, θ, φ), and the angular
 /// block of H (Eq. 12). Computed once per body and evaluation, read by every element
@@ -53,17 +64,17 @@ impl<T: Real> Turn<T> {
     /// With R = Rz(ψ)Rx(θ)Rz(φ) and E = ∂Rz/∂ψ at 0 (the cross product with z, last row
     /// and column zero): ∂R/∂ψ = E R, ∂R/∂φ = R E, ∂R/∂θ written out.
     pub fn of(r0: &[[f64; 3]; 3], e: &[T]) -> Turn<T> {
-        let s: [T; 3] = std::array::from_fn(|k| e[k].sin());
-        let c: [T; 3] = std::array::from_fn(|k| e[k].cos());
-        let ([s1, s2, s3], [c1, c2, c3]) = (s, c);
+        let (s, c) = sin_cos(e);
+        Turn::of_sc(r0, s, c)
+    }
+
+    /// [`Turn::of`] from the sines `s` and cosines `c` of the Euler angles.
+    pub fn of_sc(r0: &[[f64; 3]; 3], s: [T; 3], c: [T; 3]) -> Turn<T> {
+        let ([_, s2, s3], [_, c2, c3]) = (s, c);
         let (r, z) = (rot313_sc(s, c), T::zero());
         let m = &r.0;
         let d_psi = M3([[-m[1][0], -m[1][1], -m[1][2]], m[0], [z; 3]]);
-        let d_theta = M3([
-            [s1 * s2 * s3, s1 * s2 * c3, s1 * c2],
-            [-(c1 * s2 * s3), -(c1 * s2 * c3), -(c1 * c2)],
-            [c2 * s3, c2 * c3, -s2],
-        ]);
+        let d_theta = d_theta_sc(s, c);
         let d_phi = M3(std::array::from_fn(|i| [m[i][1], -m[i][0], z]));
         let r0 = M3::cst(r0);
         Turn { a: r0.mm(&r), da: [r0.mm(&d_psi), r0.mm(&d_theta), r0.mm(&d_phi)], h: h_angular_sc(s2, c2, s3, c3) }
@@ -73,17 +84,11 @@ impl<T: Real> Turn<T> {
 /// The second derivatives ∂²A/∂e_m∂e_n of a body's rotation A = R0 · Rz(ψ)Rx(θ)Rz(φ) by
 /// its Euler angles e = (ψ, θ, φ) (symmetric in m, n). With E as in [`Turn::of`]
 /// (E² = −diag(1, 1, 0)): R_ψψ = E²R, R_φφ = RE², R_ψφ = ERE, R_ψθ = E R_θ, R_θφ = R_θ E,
-/// and R_θθ = −R + (Rz(ψ) x)(Rz(φ)ᵀ x)ᵀ (x the first axis: Rx'' = −Rx + x xᵀ).
-pub fn rotation_second(r0: &[[f64; 3]; 3], e: &[f64]) -> [[M3<f64>; 3]; 3] {
-    let s: [f64; 3] = std::array::from_fn(|k| e[k].sin());
-    let c: [f64; 3] = std::array::from_fn(|k| e[k].cos());
-    let r = rot313_sc(s, c).0;
-    let ([s1, s2, s3], [c1, c2, c3]) = (s, c);
-    let rt = [
-        [s1 * s2 * s3, s1 * s2 * c3, s1 * c2],
-        [-(c1 * s2 * s3), -(c1 * s2 * c3), -(c1 * c2)],
-        [c2 * s3, c2 * c3, -s2],
-    ];
+/// and R_θθ = −R + (Rz(ψ) x)(Rz(φ)ᵀ x)ᵀ (x the first axis: Rx'' = −Rx + x xᵀ). From the
+/// sines `s` and cosines `c` of the angles ([`sin_cos`]).
+pub fn rotation_second(r0: &[[f64; 3]; 3], s: [f64; 3], c: [f64; 3]) -> [[M3<f64>; 3]; 3] {
+    let (r, rt) = (rot313_sc(s, c).0, d_theta_sc(s, c).0);
+    let ([s1, _, s3], [c1, _, c3]) = (s, c);
     // E M: rows (−M₁, M₀, 0); M E: columns (M·₁, −M·₀, 0).
     let el = |m: &[[f64; 3]; 3]| [[-m[1][0], -m[1][1], -m[1][2]], m[0], [0.0; 3]];
     let er = |m: &[[f64; 3]; 3]| std::array::from_fn(|i| [m[i][1], -m[i][0], 0.0]);

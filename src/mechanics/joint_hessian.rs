@@ -6,7 +6,7 @@
 //! [`rotation_second`]) or a constant (ground, a unit vector); the product rule gives the
 //! gradient and the Hessian of each dot product in plain numbers.
 
-use super::body::{NQ, Turn, rotation_second};
+use super::body::{NQ, Turn, rotation_second, sin_cos};
 use super::constraints::ConstraintEl;
 use super::coords::nql;
 use super::joint_table::{Row, equations, rigid_joint};
@@ -103,8 +103,8 @@ impl Marker {
         let body = g.body.map(|b| {
             let kb = el.bodies.iter().position(|&x| x == b).expect("a joint's marker body is one of its bodies");
             let qb = &q[NQ * b..NQ * b + NQ];
-            let e = &qb[3..NQ];
-            (NQ * kb, V3([qb[0], qb[1], qb[2]]), Turn::of(&sys.r0[b], e), rotation_second(&sys.r0[b], e))
+            let (s, c) = sin_cos(&qb[3..NQ]);
+            (NQ * kb, V3([qb[0], qb[1], qb[2]]), Turn::of_sc(&sys.r0[b], s, c), rotation_second(&sys.r0[b], s, c))
         });
         Marker { body, s: V3(g.s), local_axes }
     }
