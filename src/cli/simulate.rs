@@ -277,6 +277,7 @@ impl StatsReport {
             ("rejected steps", s.rejected),
             ("Newton iterations", s.newton_iterations),
             ("Jacobian evaluations", s.jacobians),
+            ("  exact ones", s.exact_jacobians),
             ("factorizations", s.factorizations),
             ("  by the general LU", s.general_factorizations),
             ("symbolic analyses", s.symbolic_analyses),

@@ -55,6 +55,9 @@ pub struct Stats {
     pub newton_iterations: usize,
     /// Evaluations of J = ∂f/∂y.
     pub jacobians: usize,
+    /// Of those, the exact J (not the problem's cheaper approximation; see
+    /// [`DaeProblem::set_exact_jacobian`]).
+    pub exact_jacobians: usize,
     /// Numeric factorizations of the iteration matrices (one counts both the real n×n
     /// and the 2n×2n complex-pair block).
     pub factorizations: usize,
@@ -482,6 +485,7 @@ impl Radau {
             p.set_exact_jacobian(self.exact_jac);
             p.jacobian(self.t, &self.y, &mut self.jac)?;
             self.stats.jacobians += 1;
+            self.stats.exact_jacobians += usize::from(self.exact_jac);
             self.jac_fresh = true;
             self.need_jac = false;
             self.h_fact = f64::NAN;

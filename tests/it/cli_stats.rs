@@ -44,12 +44,13 @@ impl Report {
     }
 }
 
-const LABELS: [&str; 9] = [
+const LABELS: [&str; 10] = [
     "steps attempted",
     "accepted steps",
     "rejected steps",
     "Newton iterations",
     "Jacobian evaluations",
+    "exact ones",
     "factorizations",
     "by the general LU",
     "symbolic analyses",
@@ -102,6 +103,7 @@ fn simulate_stats_prints_consistent_counts_equal_to_the_engines() {
         s.rejected,
         s.newton_iterations,
         s.jacobians,
+        s.exact_jacobians,
         s.factorizations,
         s.general_factorizations,
         s.symbolic_analyses,
