@@ -133,3 +133,34 @@ fn simulate_without_stats_prints_none_and_a_failed_run_prints_the_work_up_to_the
     // The statistics come before the error line.
     assert!(err.find("integrator statistics").unwrap() < err.find("error:").unwrap(), "{err}");
 }
+
+#[test]
+fn a_run_that_needs_the_exact_jacobian_counts_it_and_keeps_it() {
+    // The four-bar at 1e-6: its Newton iteration soon fails with the within-body
+    // approximation of J (a closed loop's reactions couple its links), and the run takes
+    // the exact J from then on.
+    let o = mbfmu(&["simulate", "models/fourbar.xml", "--end", "0.2", "--step", "0.01", "--tol", "1e-6", "--stats"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    let r = Report::parse(&err);
+    let (jac, exact) = (r.total("Jacobian evaluations"), r.total("exact ones"));
+    assert!(exact > 0, "the run switched to the exact J: {err}");
+    assert!(exact < jac, "the first J is the approximation: {err}");
+
+    let m = model("fourbar.xml");
+    let mut sim = Simulator::new(&m, SimOptions { tol: 1e-6, ..Default::default() }, 0.0).unwrap();
+    let mut approximate_after_switch = None;
+    for k in 1..=20 {
+        sim.advance(k as f64 * 0.01).unwrap();
+        let s = sim.stats();
+        let approximate = s.jacobians - s.exact_jacobians;
+        if let Some(a) = approximate_after_switch {
+            assert_eq!(approximate, a, "no approximate J after the switch (communication step {k})");
+        } else if s.exact_jacobians > 0 {
+            approximate_after_switch = Some(approximate);
+        }
+    }
+    let s = sim.stats();
+    assert_eq!((s.jacobians, s.exact_jacobians), (jac, exact), "the printed counts are the engine's");
+    assert!(approximate_after_switch.is_some());
+}
