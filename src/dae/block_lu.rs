@@ -2,15 +2,20 @@
 //!
 //! The unknowns come in groups the DAE names (a body's q, u and accelerations; a
 //! constraint element's λ and μ; …). The groups are eliminated in a minimum-degree order
-//! of the group graph in which a group whose rows have no diagonal entries (the
-//! multipliers) waits until every body it touches is gone, so that its diagonal block is
-//! the Schur complement −C D⁻¹ Cᵀ of whole constraint rows (see `analyze`). On a tree
-//! of bodies (a chain, a vehicle's suspensions) the work is linear in the number of
-//! bodies with dense kernels of the bodies' size, as in Baraff's linear-time
-//! Lagrange-multiplier method, here for any matrix with this pattern. Partial pivoting
-//! works inside each diagonal block only; a pivot below [`PIVOT_TOL`] times the largest
-//! entry of its column fails the factorization, and the caller falls back to the
-//! general sparse LU with row pivoting ([`super::sparse::SparseLu`]).
+//! of the group graph. A group whose rows have no diagonal entries (the multipliers)
+//! goes, in the early order, as soon as the bodies eliminated before it can carry its
+//! rows (a chain's joint right after its child body, Baraff's order: fronts of one
+//! body or one joint), and in the waiting order only once every body it touches is
+//! gone, so that its diagonal block is the Schur complement −C D⁻¹ Cᵀ of whole
+//! constraint rows (see `analyze`). The early order factors first; a pivot too small
+//! there (rows the eliminated bodies could not carry after all) hands that matrix to
+//! the waiting order. On a tree of bodies (a chain, a vehicle's suspensions) the work is
+//! linear in the number of bodies with dense kernels of the bodies' size, as in
+//! Baraff's linear-time Lagrange-multiplier method, here for any matrix with this
+//! pattern. Partial pivoting works inside each diagonal block only; a pivot below
+//! [`PIVOT_TOL`] times the largest entry of its column fails the factorization in both
+//! orders, and the caller falls back to the general sparse LU with row pivoting
+//! ([`super::sparse::SparseLu`]).
 
 use super::sparse::LuScalar;
 use faer::sparse::Pair;
@@ -65,6 +70,8 @@ struct Symbolic {
     /// The groups still present at each step, concatenated (see [`Step`]).
     later: Vec<usize>,
     arena: usize,
+    /// Whether a constraint group went before all of its bodies.
+    early: bool,
 }
 
 /// One group's elimination: its diagonal block at `diag`; its neighbours not yet
@@ -79,10 +86,61 @@ struct Step {
     o0: usize,
 }
 
-/// A sparse LU by dense blocks of unknown groups (module docs). Reuses its symbolic
-/// analysis while the pattern and the groups are unchanged; a refactorization
-/// allocates nothing.
+/// A sparse LU by dense blocks of unknown groups (module docs): in the order that takes a
+/// constraint group as soon as the bodies eliminated before it can carry its rows, else
+/// (a pivot too small in that order, and only for that factorization) in the order that
+/// waits for all of its bodies. Reuses its symbolic analyses while the pattern and the
+/// groups are unchanged; a refactorization allocates nothing.
 pub struct BlockLu<T: LuScalar> {
+    /// The early order, then the waiting one (see [`analyze`]).
+    orders: [OrderedLu<T>; 2],
+    /// Which of `orders` holds the last factorization.
+    active: usize,
+    /// Number of symbolic analyses performed.
+    pub analyses: usize,
+}
+
+impl<T: LuScalar> Default for BlockLu<T> {
+    fn default() -> Self {
+        BlockLu { orders: [OrderedLu::new(true), OrderedLu::new(false)], active: 0, analyses: 0 }
+    }
+}
+
+impl<T: LuScalar> BlockLu<T> {
+    /// Factor the n×n matrix with entries `vals` at `idx` (duplicates summed), unknown i
+    /// in group `groups[i]`. Fails (and holds no factorization) when a pivot is too small
+    /// for elimination without pivoting between groups in both orders, or a value is not
+    /// finite. Which order factors depends on the matrix alone.
+    pub fn factor(&mut self, n: usize, idx: &[Pair<usize, usize>], vals: &[T], groups: &[usize]) -> Result<(), String> {
+        self.orders[1].factored = false;
+        let first = self.orders[0].factor(n, idx, vals, groups);
+        let r = match first {
+            Ok(()) => {
+                self.active = 0;
+                Ok(())
+            }
+            // The early order is the waiting one here: nothing else to try.
+            Err(e) if !self.orders[0].sym.as_ref().is_some_and(|s| s.early) => Err(e),
+            Err(_) => {
+                self.active = 1;
+                self.orders[1].factor(n, idx, vals, groups)
+            }
+        };
+        self.analyses = self.orders[0].analyses + self.orders[1].analyses;
+        r
+    }
+
+    /// Solve A x = b in place; false if there is no factorization or the result is not
+    /// finite.
+    pub fn solve(&mut self, b: &mut [T]) -> bool {
+        self.orders[self.active].solve(b)
+    }
+}
+
+/// The block LU in one elimination order.
+struct OrderedLu<T: LuScalar> {
+    /// Whether constraint groups go early ([`analyze`]).
+    early: bool,
     sym: Option<Symbolic>,
     arena: Vec<T>,
     /// Row interchanges of each diagonal block (LAPACK's ipiv, local indices), by `start`.
@@ -95,12 +153,13 @@ pub struct BlockLu<T: LuScalar> {
     w: Vec<T>,
     factored: bool,
     /// Number of symbolic analyses performed.
-    pub analyses: usize,
+    analyses: usize,
 }
 
-impl<T: LuScalar> Default for BlockLu<T> {
-    fn default() -> Self {
-        BlockLu {
+impl<T: LuScalar> OrderedLu<T> {
+    fn new(early: bool) -> Self {
+        OrderedLu {
+            early,
             sym: None,
             arena: Vec::new(),
             piv: Vec::new(),
@@ -111,17 +170,13 @@ impl<T: LuScalar> Default for BlockLu<T> {
             analyses: 0,
         }
     }
-}
 
-impl<T: LuScalar> BlockLu<T> {
-    /// Factor the n×n matrix with entries `vals` at `idx` (duplicates summed), unknown i
-    /// in group `groups[i]`. Fails (and holds no factorization) when a pivot is too small
-    /// for elimination without pivoting between groups, or a value is not finite.
-    pub fn factor(&mut self, n: usize, idx: &[Pair<usize, usize>], vals: &[T], groups: &[usize]) -> Result<(), String> {
+    /// [`BlockLu::factor`] in this order.
+    fn factor(&mut self, n: usize, idx: &[Pair<usize, usize>], vals: &[T], groups: &[usize]) -> Result<(), String> {
         self.factored = false;
         let reuse = matches!(&self.sym, Some(s) if s.n == n && s.pattern == idx && s.groups == groups);
         if !reuse {
-            let s = analyze(n, idx, groups)?;
+            let s = analyze(n, idx, groups, self.early)?;
             self.arena = vec![<T as LuScalar>::zero(); s.arena];
             let widest = (0..s.start.len() - 1).map(|g| size(&s, g)).max().unwrap_or(0);
             let wide = s.steps.iter().map(|st| (0..st.nl).map(|j| size(&s, s.later[st.l0 + j])).sum::<usize>());
@@ -149,9 +204,8 @@ impl<T: LuScalar> BlockLu<T> {
         Ok(())
     }
 
-    /// Solve A x = b in place; false if there is no factorization or the result is not
-    /// finite.
-    pub fn solve(&mut self, b: &mut [T]) -> bool {
+    /// [`BlockLu::solve`] in this order.
+    fn solve(&mut self, b: &mut [T]) -> bool {
         let Some(s) = self.sym.as_ref().filter(|_| self.factored) else { return false };
         let (a, rdiag, piv, w) = (&self.arena[..], &self.rdiag[..], &self.piv[..], &mut self.w[..]);
         wide_or_baseline!(solve_in_avx2, solve_in, (s, a, rdiag, piv, w, b));
@@ -489,7 +543,7 @@ fn lu_in_place<T: LuScalar>(d: &mut [T], s: usize, piv: &mut [usize]) -> Result<
 
 /// The symbolic analysis: groups, their graph, the elimination order, the blocks of the
 /// filled pattern and the arena places of the entries.
-fn analyze(n: usize, idx: &[Pair<usize, usize>], groups: &[usize]) -> Result<Symbolic, String> {
+fn analyze(n: usize, idx: &[Pair<usize, usize>], groups: &[usize], early: bool) -> Result<Symbolic, String> {
     if groups.len() != n {
         return Err(format!("{} groups for {n} unknowns", groups.len()));
     }
@@ -536,8 +590,39 @@ fn analyze(n: usize, idx: &[Pair<usize, usize>], groups: &[usize]) -> Result<Sym
     let touches: Vec<Vec<usize>> = (0..ng)
         .map(|g| if full[g] { adj[g].iter().copied().filter(|&j| !full[j]).collect() } else { Vec::new() })
         .collect();
+    //
+    // In the early order a constraint group may also go once it is the only constraint
+    // group left that the eliminated groups it is joined to (through eliminations:
+    // `cluster`) touch (`pending`), and those have more unknowns left (`free`: their
+    // bodies' unknowns less their constraint groups') than it has (more, not as many: a
+    // group of velocity rows alone, a rolling wheel's, takes no position freedom, so an
+    // exact count can still leave too few velocities): along a tree from its leaves,
+    // each joint right after its child body, as in Baraff's order.
+    // The fronts then hold one body or one joint instead of a body and its joints (and,
+    // with the cross-body terms of the exact J, a neighbour body). A joint whose rows the
+    // eliminated bodies cannot carry makes a pivot too small, and the waiting order
+    // factors that matrix instead (`BlockLu::factor`).
     let degree = |adj: &BTreeSet<usize>| adj.iter().map(|&j| sz(j)).sum::<usize>();
     let mut deg: Vec<usize> = adj.iter().map(degree).collect();
+    let mut cluster: Vec<usize> = (0..ng).collect();
+    let mut free = vec![0isize; ng];
+    let mut pending = vec![0usize; ng];
+    let mut attached: Vec<Vec<usize>> = vec![Vec::new(); ng];
+    fn root(cluster: &mut [usize], mut g: usize) -> usize {
+        while cluster[g] != g {
+            cluster[g] = cluster[cluster[g]];
+            g = cluster[g];
+        }
+        g
+    }
+    let mut roots = Vec::new();
+    let attached_roots = |g: usize, cluster: &mut [usize], attached: &[Vec<usize>], roots: &mut Vec<usize>| {
+        roots.clear();
+        roots.extend(attached[g].iter().map(|&r| root(cluster, r)));
+        roots.sort_unstable();
+        roots.dedup();
+    };
+    let mut went_early = false;
     let mut queue: BTreeSet<(usize, usize)> =
         (0..ng).filter(|&g| waiting[g] == 0 && sz(g) > 0).map(|g| (deg[g], g)).collect();
     let mut order = Vec::with_capacity(ng);
@@ -555,10 +640,24 @@ fn analyze(n: usize, idx: &[Pair<usize, usize>], groups: &[usize]) -> Result<Sym
         for &i in &touches[k] {
             waiting[i] -= 1;
         }
+        went_early |= !full[k] && waiting[k] > 0;
+        attached_roots(k, &mut cluster, &attached, &mut roots);
+        let own = if full[k] { sz(k) as isize } else { -(sz(k) as isize) };
+        free[k] = own + roots.iter().map(|&r| free[r]).sum::<isize>();
+        // The constraint groups any of the merged groups touch are k's neighbours now.
+        pending[k] = nbr.iter().filter(|&&i| !full[i]).count();
+        for &r in &roots {
+            cluster[r] = k;
+        }
         for &i in &nbr {
+            attached[i].push(k);
             queue.remove(&(deg[i], i));
             deg[i] = degree(&adj[i]);
-            if waiting[i] == 0 {
+            let carried = early && !full[i] && {
+                attached_roots(i, &mut cluster, &attached, &mut roots);
+                roots.iter().all(|&r| pending[r] == 1) && roots.iter().map(|&r| free[r]).sum::<isize>() > sz(i) as isize
+            };
+            if waiting[i] == 0 || carried {
                 queue.insert((deg[i], i));
             }
         }
@@ -601,7 +700,19 @@ fn analyze(n: usize, idx: &[Pair<usize, usize>], groups: &[usize]) -> Result<Sym
             place[&(gr, gc)] + local[p.row] + local[p.col] * sz(gr)
         })
         .collect();
-    Ok(Symbolic { n, pattern: idx.to_vec(), groups: groups.to_vec(), start, vars, slot, steps, offs, later, arena })
+    Ok(Symbolic {
+        n,
+        pattern: idx.to_vec(),
+        groups: groups.to_vec(),
+        start,
+        vars,
+        slot,
+        steps,
+        offs,
+        later,
+        arena,
+        early: went_early,
+    })
 }
 
 #[cfg(test)]
@@ -742,6 +853,7 @@ mod tests {
             let mut x = b.clone();
             assert!(blu.solve(&mut x));
             // The baseline build of the numeric factorization, from the same entries.
+            let blu = &blu.orders[blu.active];
             let s = blu.sym.as_ref().expect("analysed");
             let mut a = vec![<T as LuScalar>::zero(); s.arena];
             for (&k, &v) in s.slot.iter().zip(&vals) {
@@ -763,6 +875,63 @@ mod tests {
             |i, v| c64::new(v, 0.3 * (i as f64).cos()),
             |v: &[c64]| v.iter().flat_map(|x| [x.re.to_bits(), x.im.to_bits()]).collect(),
         );
+    }
+
+    /// The sum over the elimination steps of the unknowns in their fronts.
+    fn fronts(s: &Symbolic) -> usize {
+        s.steps.iter().map(|st| (0..st.nl).map(|j| size(s, s.later[st.l0 + j])).sum::<usize>()).sum()
+    }
+
+    #[test]
+    fn an_open_chain_goes_in_the_early_order_with_narrower_fronts() {
+        let (n, idx, vals, groups) = chain(30, false);
+        let mut blu = BlockLu::<f64>::default();
+        blu.factor(n, &idx, &vals, &groups).expect("block LU");
+        assert_eq!(blu.active, 0, "the early order factors an open chain");
+        let early = blu.orders[0].sym.as_ref().unwrap();
+        assert!(early.early, "a constraint group went before both of its bodies");
+        // From an end: each body's front is its one remaining constraint (2 unknowns),
+        // each constraint's its other body (3), at most 2·30 + 3·29 in all; waiting, a
+        // body meets both of its constraints.
+        let waiting = analyze(n, &idx, &groups, false).unwrap();
+        assert!(!waiting.early);
+        assert!(fronts(early) <= 2 * 30 + 3 * 29, "{}", fronts(early));
+        assert!(fronts(early) < fronts(&waiting), "{} vs {}", fronts(early), fronts(&waiting));
+        assert_eq!(blu.analyses, 1, "the waiting order was not needed");
+    }
+
+    #[test]
+    fn a_constraint_the_bodies_before_it_cannot_carry_goes_to_the_waiting_order() {
+        // Three bodies in a row; the first constraint's two rows are equal on the first
+        // body's columns, so after that body alone its block −C D⁻¹ Cᵀ has rank 1, and
+        // the early order (body 2, its constraint, body 0, then this constraint) fails.
+        let (n, idx, mut vals, groups) = chain(3, false);
+        let row = 9;
+        let at: HashMap<(usize, usize), usize> = idx.iter().enumerate().map(|(k, p)| ((p.row, p.col), k)).collect();
+        for c in 0..3 {
+            vals[at[&(row + 1, c)]] = vals[at[&(row, c)]];
+            vals[at[&(c, row + 1)]] = vals[at[&(c, row)]];
+        }
+        let mut blu = BlockLu::<f64>::default();
+        blu.factor(n, &idx, &vals, &groups).expect("the waiting order factors it");
+        assert_eq!(blu.active, 1);
+        let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).cos()).collect();
+        let mut x = b.clone();
+        assert!(blu.solve(&mut x));
+        // Against the general LU with row pivoting (this matrix is nonsingular: the
+        // second body's columns give the constraint full rank).
+        let mut glu = SparseLu::<f64>::default();
+        glu.factor_values(n, &idx, &vals).expect("general LU");
+        let mut xg = b.clone();
+        assert!(glu.solve(&mut xg));
+        let diff = x.iter().zip(&xg).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+        assert!(diff < 1e-10, "differs from the general LU by {diff:e}");
+        assert!(residual(n, &idx, &vals, &x, &b) < 1e-12);
+        // The order follows the matrix alone: the regular chain goes early again.
+        let (_, _, regular, _) = chain(3, false);
+        blu.factor(n, &idx, &regular, &groups).expect("block LU");
+        assert_eq!(blu.active, 0);
+        assert_eq!(blu.analyses, 2, "each order analysed once");
     }
 
     #[test]
