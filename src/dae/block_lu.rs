@@ -71,7 +71,7 @@ struct Symbolic {
     later: Vec<usize>,
     arena: usize,
     /// Whether a constraint group went before all of its bodies.
-    early: bool,
+    went_early: bool,
 }
 
 /// One group's elimination: its diagonal block at `diag`; its neighbours not yet
@@ -113,14 +113,13 @@ impl<T: LuScalar> BlockLu<T> {
     /// finite. Which order factors depends on the matrix alone.
     pub fn factor(&mut self, n: usize, idx: &[Pair<usize, usize>], vals: &[T], groups: &[usize]) -> Result<(), String> {
         self.orders[1].factored = false;
-        let first = self.orders[0].factor(n, idx, vals, groups);
-        let r = match first {
+        let r = match self.orders[0].factor(n, idx, vals, groups) {
             Ok(()) => {
                 self.active = 0;
                 Ok(())
             }
             // The early order is the waiting one here: nothing else to try.
-            Err(e) if !self.orders[0].sym.as_ref().is_some_and(|s| s.early) => Err(e),
+            Err(e) if !self.orders[0].sym.as_ref().is_some_and(|s| s.went_early) => Err(e),
             Err(_) => {
                 self.active = 1;
                 self.orders[1].factor(n, idx, vals, groups)
@@ -179,8 +178,7 @@ impl<T: LuScalar> OrderedLu<T> {
             let s = analyze(n, idx, groups, self.early)?;
             self.arena = vec![<T as LuScalar>::zero(); s.arena];
             let widest = (0..s.start.len() - 1).map(|g| size(&s, g)).max().unwrap_or(0);
-            let wide = s.steps.iter().map(|st| (0..st.nl).map(|j| size(&s, s.later[st.l0 + j])).sum::<usize>());
-            let wide = wide.max().unwrap_or(0);
+            let wide = s.steps.iter().map(|st| front(&s, st)).max().unwrap_or(0);
             self.piv = vec![0; n];
             self.rdiag = vec![<T as LuScalar>::zero(); n];
             let zero = <T as LuScalar>::zero();
@@ -297,6 +295,11 @@ fn solve_in_avx2<T: LuScalar>(s: &Symbolic, a: &[T], rdiag: &[T], piv: &[usize],
 #[inline(always)]
 fn size(s: &Symbolic, g: usize) -> usize {
     s.start[g + 1] - s.start[g]
+}
+
+/// The unknowns of the groups still present at step `st` (its front).
+fn front(s: &Symbolic, st: &Step) -> usize {
+    (0..st.nl).map(|j| size(s, s.later[st.l0 + j])).sum()
 }
 
 /// Eliminate one group (block Gaussian elimination: the row blocks A_kj stay as they
@@ -711,7 +714,7 @@ fn analyze(n: usize, idx: &[Pair<usize, usize>], groups: &[usize], early: bool) 
         offs,
         later,
         arena,
-        early: went_early,
+        went_early,
     })
 }
 
@@ -765,6 +768,16 @@ mod tests {
         (n, idx, vals, groups)
     }
 
+    /// The largest difference of x from the solution of A x = b by the independent
+    /// general LU (row pivoting).
+    fn off_general(n: usize, idx: &[Pair<usize, usize>], vals: &[f64], x: &[f64], b: &[f64]) -> f64 {
+        let mut glu = SparseLu::<f64>::default();
+        glu.factor_values(n, idx, vals).expect("general LU");
+        let mut xg = b.to_vec();
+        assert!(glu.solve(&mut xg));
+        x.iter().zip(&xg).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max)
+    }
+
     fn residual(n: usize, idx: &[Pair<usize, usize>], vals: &[f64], x: &[f64], b: &[f64]) -> f64 {
         let mut ax = vec![0.0; n];
         for (p, v) in idx.iter().zip(vals) {
@@ -784,11 +797,7 @@ mod tests {
             assert!(blu.solve(&mut x));
             // Against the independent general LU (row pivoting): the same solution to
             // round-off of this well-conditioned matrix, and a residual at round-off.
-            let mut glu = SparseLu::<f64>::default();
-            glu.factor_values(n, &idx, &vals).expect("general LU");
-            let mut xg = b.clone();
-            assert!(glu.solve(&mut xg));
-            let diff = x.iter().zip(&xg).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+            let diff = off_general(n, &idx, &vals, &x, &b);
             assert!(diff < 1e-11, "close {close}: differs from the general LU by {diff:e}");
             assert!(residual(n, &idx, &vals, &x, &b) < 1e-12);
             // A refactorization with new values reuses the analysis.
@@ -879,7 +888,7 @@ mod tests {
 
     /// The sum over the elimination steps of the unknowns in their fronts.
     fn fronts(s: &Symbolic) -> usize {
-        s.steps.iter().map(|st| (0..st.nl).map(|j| size(s, s.later[st.l0 + j])).sum::<usize>()).sum()
+        s.steps.iter().map(|st| front(s, st)).sum()
     }
 
     #[test]
@@ -889,12 +898,12 @@ mod tests {
         blu.factor(n, &idx, &vals, &groups).expect("block LU");
         assert_eq!(blu.active, 0, "the early order factors an open chain");
         let early = blu.orders[0].sym.as_ref().unwrap();
-        assert!(early.early, "a constraint group went before both of its bodies");
+        assert!(early.went_early, "a constraint group went before both of its bodies");
         // From an end: each body's front is its one remaining constraint (2 unknowns),
         // each constraint's its other body (3), at most 2·30 + 3·29 in all; waiting, a
         // body meets both of its constraints.
         let waiting = analyze(n, &idx, &groups, false).unwrap();
-        assert!(!waiting.early);
+        assert!(!waiting.went_early);
         assert!(fronts(early) <= 2 * 30 + 3 * 29, "{}", fronts(early));
         assert!(fronts(early) < fronts(&waiting), "{} vs {}", fronts(early), fronts(&waiting));
         assert_eq!(blu.analyses, 1, "the waiting order was not needed");
@@ -920,11 +929,7 @@ mod tests {
         assert!(blu.solve(&mut x));
         // Against the general LU with row pivoting (this matrix is nonsingular: the
         // second body's columns give the constraint full rank).
-        let mut glu = SparseLu::<f64>::default();
-        glu.factor_values(n, &idx, &vals).expect("general LU");
-        let mut xg = b.clone();
-        assert!(glu.solve(&mut xg));
-        let diff = x.iter().zip(&xg).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+        let diff = off_general(n, &idx, &vals, &x, &b);
         assert!(diff < 1e-10, "differs from the general LU by {diff:e}");
         assert!(residual(n, &idx, &vals, &x, &b) < 1e-12);
         // The order follows the matrix alone: the regular chain goes early again.
